@@ -1,0 +1,367 @@
+//! The 8-node ANCF brick element: reference data and element kernels.
+//!
+//! Notation (seed 000 §3): x is the straight configuration (a box of edge lengths
+//! L_x, L_y, L_z), X the stress-free curved reference configuration, r the current one.
+//! With the normalized coordinates ξ ∈ [−1, 1]³ and the scaled nodal coordinates
+//! ê_a = s_a e_a (see [`crate::shape`]):
+//!
+//! - Ĵ₀ = ∂X/∂ξ = Σ_a ê₀_a ⊗ ∂n_a/∂ξ, constant in time;
+//! - F = ∂r/∂X = (Σ_a ê_a ⊗ ∂n_a/∂ξ) Ĵ₀⁻¹, the deformation gradient (seed: J = J_e J₀⁻¹);
+//! - dV₀ = det Ĵ₀ dξ, so a quadrature weight becomes w·det Ĵ₀.
+//!
+//! The generalized internal force is f = ∫ P : ∂F/∂e dV₀ (so that M ë = Q_ext − f),
+//! with P the first Piola stress of [`crate::constitutive`]. Its Jacobians
+//! K = ∂f/∂e and C = ∂f/∂ė are exact.
+//!
+//! Each force term uses its own quadrature rule ([`QuadratureOptions`]): at least 3×3×3
+//! points for the viscous term (2×2×2 leaves 42 spurious zero-energy modes per element,
+//! see `docs/architecture.md`), a reduced rule for the volumetric penalty against
+//! locking (seed 000 §8), and 4×4×4 points for the mass matrix (its integrand is of
+//! degree 6 per direction on an undistorted element, so 4 points are exact).
+
+use nalgebra::Vector3;
+
+use crate::constitutive::{Fluid, M3, Tangent};
+use crate::error::{AncfError, Result, invalid};
+use crate::quadrature::{CubeRule, MAX_GAUSS_POINTS};
+use crate::shape::{N_COORDS, N_SHAPE, normalized_shape, slope_scale};
+
+/// Points per direction of each quadrature rule.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct QuadratureOptions {
+    /// Rule for the viscous (deviatoric) stress; ≥ 3 (default 3).
+    pub viscous: usize,
+    /// Rule for the volumetric penalty and its damping (default 2, reduced).
+    pub penalty: usize,
+    /// Rule for the mass matrix and gravity (default 4, exact).
+    pub mass: usize,
+}
+
+impl Default for QuadratureOptions {
+    fn default() -> Self {
+        Self { viscous: 3, penalty: 2, mass: 4 }
+    }
+}
+
+impl QuadratureOptions {
+    /// Check the rules; the viscous rule must have at least 3 points per direction.
+    pub fn validate(&self) -> Result<()> {
+        let allowed = format!("an integer in [3, {MAX_GAUSS_POINTS}] (2 leaves spurious zero-energy modes)");
+        if !(3..=MAX_GAUSS_POINTS).contains(&self.viscous) {
+            return Err(invalid("quadrature.viscous", self.viscous, &allowed));
+        }
+        if !(1..=MAX_GAUSS_POINTS).contains(&self.penalty) {
+            return Err(invalid("quadrature.penalty", self.penalty, &format!("an integer in [1, {MAX_GAUSS_POINTS}]")));
+        }
+        if !(2..=MAX_GAUSS_POINTS).contains(&self.mass) {
+            return Err(invalid("quadrature.mass", self.mass, &format!("an integer in [2, {MAX_GAUSS_POINTS}]")));
+        }
+        Ok(())
+    }
+}
+
+/// Normalized shape functions and derivatives tabulated at the points of one rule.
+/// Shared by every element.
+#[derive(Debug, Clone)]
+pub struct ShapeTable {
+    /// The quadrature rule.
+    pub rule: CubeRule,
+    /// n_a at each point.
+    pub n: Vec<[f64; N_SHAPE]>,
+    /// ∂n_a/∂ξ_j at each point.
+    pub dn: Vec<[[f64; 3]; N_SHAPE]>,
+}
+
+impl ShapeTable {
+    /// Tabulate the shape functions at an `n × n × n` Gauss rule.
+    pub fn gauss(n: usize) -> Result<Self> {
+        let rule = CubeRule::gauss(n)?;
+        let (nn, dn) = rule.points.iter().map(|p| normalized_shape(*p)).unzip();
+        Ok(Self { rule, n: nn, dn })
+    }
+
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.rule.len()
+    }
+
+    /// True when empty (never for a valid table).
+    pub fn is_empty(&self) -> bool {
+        self.rule.is_empty()
+    }
+}
+
+/// Shape tables of the three rules.
+#[derive(Debug, Clone)]
+pub struct ShapeTables {
+    /// Rule options used.
+    pub options: QuadratureOptions,
+    /// Viscous rule.
+    pub viscous: ShapeTable,
+    /// Penalty rule.
+    pub penalty: ShapeTable,
+    /// Mass rule.
+    pub mass: ShapeTable,
+}
+
+impl ShapeTables {
+    /// Build the tables for the given options.
+    pub fn new(options: QuadratureOptions) -> Result<Self> {
+        options.validate()?;
+        Ok(Self {
+            options,
+            viscous: ShapeTable::gauss(options.viscous)?,
+            penalty: ShapeTable::gauss(options.penalty)?,
+            mass: ShapeTable::gauss(options.mass)?,
+        })
+    }
+}
+
+/// Reference data of one element at one quadrature point.
+#[derive(Debug, Clone, Copy)]
+pub struct RefPoint {
+    /// Ĵ₀⁻¹ = (∂X/∂ξ)⁻¹.
+    pub jinv: M3,
+    /// Quadrature weight times det Ĵ₀ (the reference volume the point represents).
+    pub wdet: f64,
+}
+
+/// Reference (stress-free) data of one element.
+#[derive(Debug, Clone)]
+pub struct ElementRef {
+    /// Straight-configuration edge lengths L_x, L_y, L_z.
+    pub lengths: [f64; 3],
+    /// Slope scales s_a.
+    pub scale: [f64; N_SHAPE],
+    /// Points of the viscous rule.
+    pub viscous: Vec<RefPoint>,
+    /// Points of the penalty rule.
+    pub penalty: Vec<RefPoint>,
+    /// Points of the mass rule.
+    pub mass: Vec<RefPoint>,
+    /// Reference volume V₀ (mass rule).
+    pub volume: f64,
+}
+
+/// Element coordinates in compact form: `e[a]` is the 3-vector of compact column `a`.
+pub type Compact = [[f64; 3]; N_SHAPE];
+
+/// Gradient ∂X/∂ξ of scaled compact coordinates at a point.
+#[inline]
+fn grad_xi(ehat: &Compact, dn: &[[f64; 3]; N_SHAPE]) -> M3 {
+    let mut g = M3::zeros();
+    for a in 0..N_SHAPE {
+        for i in 0..3 {
+            let v = ehat[a][i];
+            g[(i, 0)] += v * dn[a][0];
+            g[(i, 1)] += v * dn[a][1];
+            g[(i, 2)] += v * dn[a][2];
+        }
+    }
+    g
+}
+
+impl ElementRef {
+    /// Reference data from the element's reference nodal coordinates `e0` (compact,
+    /// physical gradients) and straight edge lengths. `index` is used in errors.
+    pub fn new(index: usize, e0: &Compact, lengths: [f64; 3], tables: &ShapeTables) -> Result<Self> {
+        for (j, l) in lengths.iter().enumerate() {
+            if !(l.is_finite() && *l > 0.0) {
+                return Err(invalid(&format!("element {index} length[{j}]"), l, "a finite number > 0"));
+            }
+        }
+        let mut scale = [0.0; N_SHAPE];
+        for (a, s) in scale.iter_mut().enumerate() {
+            *s = slope_scale(a, &lengths);
+        }
+        let ehat = scaled(e0, &scale);
+        let points = |t: &ShapeTable| -> Result<Vec<RefPoint>> {
+            t.dn.iter()
+                .zip(&t.rule.weights)
+                .enumerate()
+                .map(|(p, (dn, w))| {
+                    let j0 = grad_xi(&ehat, dn);
+                    let det = j0.determinant();
+                    if !(det > 0.0) || !det.is_finite() {
+                        return Err(AncfError::DegenerateReference { element: index, point: p, det });
+                    }
+                    Ok(RefPoint { jinv: j0.try_inverse().expect("det > 0"), wdet: w * det })
+                })
+                .collect()
+        };
+        let viscous = points(&tables.viscous)?;
+        let penalty = points(&tables.penalty)?;
+        let mass = points(&tables.mass)?;
+        let volume = mass.iter().map(|p| p.wdet).sum();
+        Ok(Self { lengths, scale, viscous, penalty, mass, volume })
+    }
+
+    /// Compact 32×32 scalar mass matrix ∫ρ N_a N_b dV₀ (row-major). The full 96×96 mass
+    /// matrix is this ⊗ I₃ (seed 000 eq. 9).
+    pub fn mass_compact(&self, density: f64, tables: &ShapeTables) -> Vec<f64> {
+        let mut m = vec![0.0; N_SHAPE * N_SHAPE];
+        for (p, rp) in self.mass.iter().enumerate() {
+            let n = &tables.mass.n[p];
+            let w = density * rp.wdet;
+            for a in 0..N_SHAPE {
+                let na = w * n[a] * self.scale[a];
+                for b in 0..N_SHAPE {
+                    m[a * N_SHAPE + b] += na * n[b] * self.scale[b];
+                }
+            }
+        }
+        m
+    }
+
+    /// ∫ρ N_a dV₀ for each compact column: the gravity force is this times g.
+    pub fn gravity_scale(&self, density: f64, tables: &ShapeTables) -> [f64; N_SHAPE] {
+        let mut g = [0.0; N_SHAPE];
+        for (p, rp) in self.mass.iter().enumerate() {
+            let n = &tables.mass.n[p];
+            for a in 0..N_SHAPE {
+                g[a] += density * rp.wdet * n[a] * self.scale[a];
+            }
+        }
+        g
+    }
+
+    /// Current volume ∫ J dV₀ (evaluated with the viscous rule).
+    pub fn volume_current(&self, e: &Compact, tables: &ShapeTables) -> f64 {
+        let ehat = scaled(e, &self.scale);
+        self.viscous
+            .iter()
+            .zip(&tables.viscous.dn)
+            .map(|(rp, dn)| rp.wdet * (grad_xi(&ehat, dn) * rp.jinv).determinant())
+            .sum()
+    }
+
+    /// Internal force f = ∫ P : ∂F/∂e dV₀ of the element (compact, 96 entries
+    /// `f[3a + i]`), and optionally the Jacobians K = ∂f/∂e and C = ∂f/∂ė (row-major
+    /// 96×96). `index` is used in errors.
+    pub fn internal_force(
+        &self,
+        index: usize,
+        fluid: &Fluid,
+        tables: &ShapeTables,
+        e: &Compact,
+        edot: &Compact,
+        force: &mut [f64; N_COORDS],
+        mut jac: Option<(&mut [f64], &mut [f64])>,
+    ) -> Result<()> {
+        force.fill(0.0);
+        if let Some((k, c)) = jac.as_mut() {
+            k.fill(0.0);
+            c.fill(0.0);
+        }
+        let ehat = scaled(e, &self.scale);
+        let edhat = scaled(edot, &self.scale);
+        let mut tf: Tangent = [[0.0; 9]; 9];
+        let mut tv: Tangent = [[0.0; 9]; 9];
+        for (pass, (pts, table)) in
+            [(&self.viscous, &tables.viscous), (&self.penalty, &tables.penalty)].into_iter().enumerate()
+        {
+            let deviatoric = pass == 0;
+            if !deviatoric && fluid.bulk_penalty == 0.0 && fluid.bulk_damping == 0.0 {
+                continue;
+            }
+            for (p, (rp, dn)) in pts.iter().zip(&table.dn).enumerate() {
+                let f = grad_xi(&ehat, dn) * rp.jinv;
+                let fd = grad_xi(&edhat, dn) * rp.jinv;
+                let want_t = jac.is_some();
+                let pk = if deviatoric {
+                    let t = if want_t { Some((&mut tf, &mut tv)) } else { None };
+                    fluid.deviatoric_stress(&f, &fd, t).ok_or(AncfError::InvertedElement {
+                        element: index,
+                        point: p,
+                        j: f.determinant(),
+                    })?
+                } else {
+                    let t = if want_t { Some((&mut tf, &mut tv)) } else { None };
+                    fluid.volumetric_stress(&f, &fd, t).0
+                };
+                // B_a = Ĵ₀⁻ᵀ ∂n_a/∂ξ (so ∂F_iJ/∂ê_{a,i} = B_a,J)
+                let mut bmat = [[0.0; 3]; N_SHAPE];
+                for a in 0..N_SHAPE {
+                    let v = rp.jinv.transpose() * Vector3::new(dn[a][0], dn[a][1], dn[a][2]);
+                    bmat[a] = [v[0], v[1], v[2]];
+                }
+                let ph = rp.wdet * pk;
+                for a in 0..N_SHAPE {
+                    let sa = self.scale[a];
+                    for i in 0..3 {
+                        force[3 * a + i] +=
+                            sa * (ph[(i, 0)] * bmat[a][0] + ph[(i, 1)] * bmat[a][1] + ph[(i, 2)] * bmat[a][2]);
+                    }
+                }
+                if let Some((k, c)) = jac.as_mut() {
+                    accumulate_tangent(k, &tf, &bmat, &self.scale, rp.wdet);
+                    accumulate_tangent(c, &tv, &bmat, &self.scale, rp.wdet);
+                }
+            }
+        }
+        if force.iter().any(|v| !v.is_finite()) {
+            return Err(AncfError::NonFinite { what: "element internal force".into(), element: index });
+        }
+        Ok(())
+    }
+}
+
+/// K[(a,i),(b,k)] += w s_a s_b Σ_{J,L} B_a,J T[iJ][kL] B_b,L.
+fn accumulate_tangent(k: &mut [f64], t: &Tangent, b: &[[f64; 3]; N_SHAPE], scale: &[f64; N_SHAPE], w: f64) {
+    // tb[a][i][kL] = Σ_J B_a,J T[iJ][kL]
+    let mut tb = [[[0.0; 9]; 3]; N_SHAPE];
+    for a in 0..N_SHAPE {
+        for i in 0..3 {
+            for kl in 0..9 {
+                tb[a][i][kl] =
+                    w * scale[a] * (b[a][0] * t[3 * i][kl] + b[a][1] * t[3 * i + 1][kl] + b[a][2] * t[3 * i + 2][kl]);
+            }
+        }
+    }
+    for a in 0..N_SHAPE {
+        for i in 0..3 {
+            let row = &mut k[(3 * a + i) * N_COORDS..(3 * a + i + 1) * N_COORDS];
+            let r = &tb[a][i];
+            for bb in 0..N_SHAPE {
+                let sb = scale[bb];
+                let bv = &b[bb];
+                for kk in 0..3 {
+                    row[3 * bb + kk] += sb * (r[3 * kk] * bv[0] + r[3 * kk + 1] * bv[1] + r[3 * kk + 2] * bv[2]);
+                }
+            }
+        }
+    }
+}
+
+/// Multiply compact columns by their slope scales.
+#[inline]
+pub fn scaled(e: &Compact, scale: &[f64; N_SHAPE]) -> Compact {
+    let mut out = *e;
+    for (o, s) in out.iter_mut().zip(scale) {
+        o[0] *= s;
+        o[1] *= s;
+        o[2] *= s;
+    }
+    out
+}
+
+/// Convert a flat 96-vector `e[3a + i]` into compact form.
+pub fn to_compact(e: &[f64]) -> Compact {
+    let mut c = [[0.0; 3]; N_SHAPE];
+    for a in 0..N_SHAPE {
+        c[a] = [e[3 * a], e[3 * a + 1], e[3 * a + 2]];
+    }
+    c
+}
+
+/// Reference coordinates of a box element with corner `origin` and lengths `l`, undeformed.
+pub fn box_element(origin: [f64; 3], l: [f64; 3]) -> Compact {
+    let mut e = [[0.0; 3]; N_SHAPE];
+    for (k, s) in crate::shape::NODE_SIGNS.iter().enumerate() {
+        for i in 0..3 {
+            e[4 * k][i] = origin[i] + (s[i] + 1.0) * 0.5 * l[i];
+            e[4 * k + 1 + i][i] = 1.0;
+        }
+    }
+    e
+}

@@ -1,0 +1,1 @@
+//! Sparse implicit HHT-α integrator (work in progress).

@@ -1,0 +1,14 @@
+//! Railway multibody dynamics for railslosh.
+//!
+//! Modules are grouped by physics:
+//! - [`integrator`]: the sparse implicit HHT-α integrator (faer sparse LU) that advances
+//!   rigid and ANCF bodies together;
+//! - [`track`]: track geometry from segment tables;
+//! - [`profile`]: wheel and rail profiles (analytic, splines, file import);
+//! - [`wheel_rail`]: wheel/rail contact search, Hertz normal contact and creep forces.
+#![warn(missing_docs)]
+
+pub mod integrator;
+pub mod profile;
+pub mod track;
+pub mod wheel_rail;

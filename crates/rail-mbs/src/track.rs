@@ -1,0 +1,1 @@
+//! Track geometry (work in progress).

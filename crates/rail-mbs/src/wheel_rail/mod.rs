@@ -1,0 +1,1 @@
+//! Wheel/rail contact (work in progress).

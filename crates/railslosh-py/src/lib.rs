@@ -1,0 +1,433 @@
+//! PyO3 bindings of railslosh, built by maturin as `railslosh._core`.
+//!
+//! The binding layer is thin: it converts arguments, releases the GIL around every
+//! computation (`py.detach`), maps Rust errors to Python exceptions, and catches any
+//! Rust panic so that none ever reaches Python as a `PanicException`.
+//!
+//! Error mapping: invalid parameters and wrong array sizes → `ValueError` naming the
+//! field and the allowed range; failures of a computation (inverted element, non-finite
+//! values) → `railslosh.RailsloshError`.
+
+use std::panic::{AssertUnwindSafe, catch_unwind};
+
+use ancf_core::body::FluidBody;
+use ancf_core::constitutive::{Fluid, Rheology};
+use ancf_core::element::QuadratureOptions;
+use ancf_core::error::AncfError;
+use ancf_core::mesh::{self, CylinderTankSpec, EllipticCylinderSpec, FluidMesh};
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
+use pyo3::create_exception;
+use pyo3::exceptions::{PyException, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+create_exception!(_core, RailsloshError, PyException, "Base class of railslosh simulation errors.");
+
+fn to_py(e: AncfError) -> PyErr {
+    match e {
+        AncfError::InvalidParameter { .. } | AncfError::DimensionMismatch { .. } => {
+            PyValueError::new_err(e.to_string())
+        }
+        other => RailsloshError::new_err(other.to_string()),
+    }
+}
+
+/// Run `f` without the GIL, converting errors and panics.
+fn compute<T: Send, F: FnOnce() -> Result<T, AncfError> + Send>(py: Python<'_>, f: F) -> PyResult<T> {
+    py.detach(|| catch_unwind(AssertUnwindSafe(f)))
+        .map_err(|p| {
+            let msg = p
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string()))
+                .unwrap_or_default();
+            RailsloshError::new_err(format!("internal error (please report): {msg}"))
+        })?
+        .map_err(to_py)
+}
+
+/// (data, indices, indptr, shape) of a CSC matrix.
+type CscArrays<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<i64>>, (usize, usize));
+
+fn vec_of(a: &PyReadonlyArray1<'_, f64>, field: &str) -> PyResult<Vec<f64>> {
+    Ok(a.as_slice()
+        .map_err(|_| PyValueError::new_err(format!("`{field}` must be a contiguous float64 array")))?
+        .to_vec())
+}
+
+/// A structured ANCF fluid mesh (reference configuration, tank frame).
+#[pyclass(name = "FluidMesh", module = "railslosh._core", frozen)]
+#[derive(Clone)]
+struct PyFluidMesh {
+    inner: FluidMesh,
+}
+
+#[pymethods]
+impl PyFluidMesh {
+    /// Node reference coordinates, shape (n_nodes, 12): r, r_x, r_y, r_z.
+    #[getter]
+    fn nodes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let flat = self.inner.reference_coordinates();
+        let n = self.inner.n_nodes();
+        Ok(PyArray1::from_vec(py, flat).reshape([n, 12])?.into_any())
+    }
+    /// Element connectivity, shape (n_elements, 8), node order A..H.
+    #[getter]
+    fn connectivity<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let flat: Vec<i64> = self.inner.elements.iter().flatten().map(|&x| x as i64).collect();
+        Ok(PyArray1::from_vec(py, flat).reshape([self.inner.n_elements(), 8])?.into_any())
+    }
+    /// Straight-configuration element edge lengths, shape (n_elements, 3).
+    #[getter]
+    fn element_lengths<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let flat: Vec<f64> = self.inner.lengths.iter().flatten().copied().collect();
+        Ok(PyArray1::from_vec(py, flat).reshape([self.inner.n_elements(), 3])?.into_any())
+    }
+    /// Boundary faces as a list of (element, face, kind) strings.
+    #[getter]
+    fn boundary(&self) -> Vec<(usize, String, String)> {
+        self.inner.boundary.iter().map(|b| (b.element, format!("{:?}", b.face), format!("{:?}", b.kind))).collect()
+    }
+    #[getter]
+    fn n_nodes(&self) -> usize {
+        self.inner.n_nodes()
+    }
+    #[getter]
+    fn n_elements(&self) -> usize {
+        self.inner.n_elements()
+    }
+    #[getter]
+    fn n_coords(&self) -> usize {
+        self.inner.n_coords()
+    }
+    /// Element counts (length, width, height).
+    #[getter]
+    fn counts(&self) -> (usize, usize, usize) {
+        let c = self.inner.counts;
+        (c[0], c[1], c[2])
+    }
+    /// Exact volume of the region the mesh approximates (m³).
+    #[getter]
+    fn exact_volume(&self) -> f64 {
+        self.inner.exact_volume
+    }
+    /// Initial free-surface height in the tank frame (m).
+    #[getter]
+    fn free_surface_z(&self) -> f64 {
+        self.inner.free_surface_z
+    }
+    #[getter]
+    fn kind(&self) -> String {
+        self.inner.kind.clone()
+    }
+    fn __repr__(&self) -> String {
+        format!(
+            "FluidMesh({}, elements={}, nodes={}, coords={})",
+            self.inner.kind,
+            self.inner.n_elements(),
+            self.inner.n_nodes(),
+            self.inner.n_coords()
+        )
+    }
+}
+
+/// Box of fluid: origin (m), size (m) and element counts.
+#[pyfunction]
+fn box_mesh(py: Python<'_>, origin: [f64; 3], size: [f64; 3], counts: [usize; 3]) -> PyResult<PyFluidMesh> {
+    compute(py, || mesh::box_mesh(origin, size, counts)).map(|inner| PyFluidMesh { inner })
+}
+
+/// Liquid in a horizontal cylinder with half-ellipsoidal heads.
+#[pyfunction]
+#[pyo3(signature = (length, radius, head_depth, fill, n_length, n_width, n_height, grading=1.0))]
+#[allow(clippy::too_many_arguments)]
+fn cylinder_tank(
+    py: Python<'_>,
+    length: f64,
+    radius: f64,
+    head_depth: f64,
+    fill: f64,
+    n_length: usize,
+    n_width: usize,
+    n_height: usize,
+    grading: f64,
+) -> PyResult<PyFluidMesh> {
+    let spec = CylinderTankSpec { length, radius, head_depth, fill, n_length, n_width, n_height, grading };
+    compute(py, || mesh::cylinder_tank(&spec)).map(|inner| PyFluidMesh { inner })
+}
+
+/// Liquid in a flat-ended cylinder of elliptical section.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+fn elliptic_cylinder(
+    py: Python<'_>,
+    length: f64,
+    semi_axis_y: f64,
+    semi_axis_z: f64,
+    fill: f64,
+    n_length: usize,
+    n_width: usize,
+    n_height: usize,
+) -> PyResult<PyFluidMesh> {
+    let spec = EllipticCylinderSpec { length, semi_axis_y, semi_axis_z, fill, n_length, n_width, n_height };
+    compute(py, || mesh::elliptic_cylinder(&spec)).map(|inner| PyFluidMesh { inner })
+}
+
+/// A fluid: density, rheology and penalty parameters (validated on construction).
+#[pyclass(name = "Fluid", module = "railslosh._core", frozen)]
+#[derive(Clone)]
+struct PyFluid {
+    inner: Fluid,
+}
+
+#[pymethods]
+impl PyFluid {
+    #[new]
+    #[pyo3(signature = (density, model, *, viscosity=0.0, yield_stress=0.0, consistency=None, power_index=1.0,
+                        elastic_modulus=None, bulk_penalty, bulk_damping=0.0, shear_rate_reg=1e-2))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        density: f64,
+        model: &str,
+        viscosity: f64,
+        yield_stress: f64,
+        consistency: Option<f64>,
+        power_index: f64,
+        elastic_modulus: Option<f64>,
+        bulk_penalty: f64,
+        bulk_damping: f64,
+        shear_rate_reg: f64,
+    ) -> PyResult<Self> {
+        let rheology = match model {
+            "newtonian" => Rheology::Newtonian { viscosity },
+            "bingham" => Rheology::Bingham { viscosity, yield_stress },
+            "herschel-bulkley" => {
+                Rheology::HerschelBulkley { consistency: consistency.unwrap_or(viscosity), power_index, yield_stress }
+            }
+            "oldroyd" => Rheology::Oldroyd { viscosity, yield_stress, elastic_modulus },
+            "casson" => Rheology::Casson { viscosity, yield_stress },
+            other => {
+                return Err(PyValueError::new_err(format!(
+                    "invalid parameter `model` = {other:?}: allowed one of newtonian, bingham, herschel-bulkley, oldroyd, casson"
+                )));
+            }
+        };
+        let f = Fluid { density, rheology, bulk_penalty, bulk_damping, shear_rate_reg, oldroyd_switch_width: 0.05 };
+        f.validate().map_err(to_py)?;
+        Ok(Self { inner: f })
+    }
+    #[getter]
+    fn density(&self) -> f64 {
+        self.inner.density
+    }
+    #[getter]
+    fn model(&self) -> &'static str {
+        self.inner.rheology.name()
+    }
+    #[getter]
+    fn yield_stress(&self) -> f64 {
+        self.inner.rheology.yield_stress()
+    }
+    #[getter]
+    fn bulk_penalty(&self) -> f64 {
+        self.inner.bulk_penalty
+    }
+    #[getter]
+    fn bulk_damping(&self) -> f64 {
+        self.inner.bulk_damping
+    }
+    /// Shear modulus of the Oldroyd elastic branch (0 for other models).
+    #[getter]
+    fn elastic_modulus(&self) -> f64 {
+        self.inner.elastic_modulus()
+    }
+    fn __repr__(&self) -> String {
+        format!("Fluid({:?})", self.inner)
+    }
+}
+
+/// A meshed fluid body: reference data, constant mass matrix, forces and Jacobians.
+#[pyclass(name = "FluidBody", module = "railslosh._core", frozen)]
+struct PyFluidBody {
+    inner: FluidBody,
+}
+
+#[pymethods]
+impl PyFluidBody {
+    #[new]
+    #[pyo3(signature = (mesh, fluid, viscous_points=3, penalty_points=2, mass_points=4))]
+    fn new(
+        py: Python<'_>,
+        mesh: &PyFluidMesh,
+        fluid: &PyFluid,
+        viscous_points: usize,
+        penalty_points: usize,
+        mass_points: usize,
+    ) -> PyResult<Self> {
+        let q = QuadratureOptions { viscous: viscous_points, penalty: penalty_points, mass: mass_points };
+        let (m, f) = (mesh.inner.clone(), fluid.inner);
+        compute(py, move || FluidBody::new(m, f, q)).map(|inner| Self { inner })
+    }
+    #[getter]
+    fn n_coords(&self) -> usize {
+        self.inner.n_coords()
+    }
+    #[getter]
+    fn total_mass(&self) -> f64 {
+        self.inner.total_mass()
+    }
+    #[getter]
+    fn reference_volume(&self) -> f64 {
+        self.inner.reference_volume()
+    }
+    #[getter]
+    fn mesh(&self) -> PyFluidMesh {
+        PyFluidMesh { inner: self.inner.mesh.clone() }
+    }
+    #[getter]
+    fn fluid(&self) -> PyFluid {
+        PyFluid { inner: self.inner.fluid }
+    }
+    /// Reference coordinates (flat, 12 per node).
+    fn reference_coordinates<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.inner.reference_coordinates())
+    }
+    /// Scalar mass matrix M_s (4N×4N) as CSC arrays (data, indices, indptr, shape).
+    fn scalar_mass_csc<'py>(&self, py: Python<'py>) -> CscArrays<'py> {
+        let m = self.inner.scalar_mass().as_ref();
+        let n = m.nrows();
+        let mut data = Vec::new();
+        let mut idx = Vec::new();
+        let mut ptr = vec![0i64];
+        for j in 0..m.ncols() {
+            for (i, v) in m.row_idx_of_col(j).zip(m.val_of_col(j)) {
+                idx.push(i as i64);
+                data.push(*v);
+            }
+            ptr.push(idx.len() as i64);
+        }
+        (PyArray1::from_vec(py, data), PyArray1::from_vec(py, idx), PyArray1::from_vec(py, ptr), (n, n))
+    }
+    /// Generalized gravity force for gravity vector g (m/s²).
+    fn gravity_force<'py>(&self, py: Python<'py>, g: [f64; 3]) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.inner.gravity_force(g))
+    }
+    /// Internal (viscous + penalty) generalized forces f(e, ė).
+    fn internal_forces<'py>(
+        &self,
+        py: Python<'py>,
+        e: PyReadonlyArray1<'py, f64>,
+        edot: PyReadonlyArray1<'py, f64>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let (e, v) = (vec_of(&e, "e")?, vec_of(&edot, "edot")?);
+        let body = &self.inner;
+        let out = compute(py, || {
+            let mut f = vec![0.0; e.len().max(body.n_coords())];
+            body.internal_forces(&e, &v, &mut f).map(|_| f)
+        })?;
+        Ok(PyArray1::from_vec(py, out))
+    }
+    /// Internal force and exact Jacobians of element `index`: (f[96], K[96,96], C[96,96]),
+    /// compact ordering 3a + i.
+    fn element_tangent<'py>(
+        &self,
+        py: Python<'py>,
+        index: usize,
+        e: PyReadonlyArray1<'py, f64>,
+        edot: PyReadonlyArray1<'py, f64>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        if index >= self.inner.elements.len() {
+            return Err(PyValueError::new_err(format!(
+                "invalid parameter `index` = {index}: allowed an integer in [0, {})",
+                self.inner.elements.len()
+            )));
+        }
+        let (e, v) = (vec_of(&e, "e")?, vec_of(&edot, "edot")?);
+        let body = &self.inner;
+        let (f, j) = compute(py, || {
+            ancf_core::error::check_len("e", e.len(), body.n_coords())?;
+            ancf_core::error::check_len("edot", v.len(), body.n_coords())?;
+            body.element_tangent(index, &e, &v)
+        })?;
+        Ok((
+            PyArray1::from_vec(py, f.to_vec()).into_any(),
+            PyArray1::from_vec(py, j.stiffness).reshape([96, 96])?.into_any(),
+            PyArray1::from_vec(py, j.damping).reshape([96, 96])?.into_any(),
+        ))
+    }
+    /// Global indices of the 96 compact coordinates of element `index`.
+    fn element_dofs(&self, index: usize) -> PyResult<Vec<usize>> {
+        if index >= self.inner.elements.len() {
+            return Err(PyValueError::new_err(format!("invalid parameter `index` = {index}")));
+        }
+        Ok((0..96).map(|c| self.inner.global_index(index, c)).collect())
+    }
+    /// Current volume ∫ J dV₀.
+    fn volume(&self, py: Python<'_>, e: PyReadonlyArray1<'_, f64>) -> PyResult<f64> {
+        let e = vec_of(&e, "e")?;
+        let body = &self.inner;
+        compute(py, || {
+            ancf_core::error::check_len("e", e.len(), body.n_coords())?;
+            Ok(body.volume(&e))
+        })
+    }
+    /// Centre of mass (m).
+    fn center_of_mass(&self, e: PyReadonlyArray1<'_, f64>) -> PyResult<[f64; 3]> {
+        let e = vec_of(&e, "e")?;
+        ancf_core::error::check_len("e", e.len(), self.inner.n_coords()).map_err(to_py)?;
+        Ok(self.inner.center_of_mass(&e))
+    }
+    /// Kinetic energy ½ ėᵀMė (J).
+    fn kinetic_energy(&self, edot: PyReadonlyArray1<'_, f64>) -> PyResult<f64> {
+        let v = vec_of(&edot, "edot")?;
+        ancf_core::error::check_len("edot", v.len(), self.inner.n_coords()).map_err(to_py)?;
+        Ok(self.inner.kinetic_energy(&v))
+    }
+}
+
+/// Names of the validation cases implemented in Rust.
+#[pyfunction]
+fn validation_cases() -> Vec<&'static str> {
+    ancf_core::validate::CASES.to_vec()
+}
+
+/// Run one validation case; returns a list of dict records.
+#[pyfunction]
+#[pyo3(signature = (name, quick=false))]
+fn run_validation<'py>(py: Python<'py>, name: String, quick: bool) -> PyResult<Vec<Bound<'py, PyDict>>> {
+    let recs = compute(py, move || ancf_core::validate::run_case(&name, quick))?;
+    recs.into_iter()
+        .map(|r| {
+            let d = PyDict::new(py);
+            d.set_item("case", r.case)?;
+            d.set_item("quantity", r.quantity)?;
+            d.set_item("measured", r.measured)?;
+            d.set_item("reference", r.reference)?;
+            d.set_item("tolerance", r.tolerance)?;
+            d.set_item("passed", r.passed)?;
+            Ok(d)
+        })
+        .collect()
+}
+
+/// Test hook: proves that a Rust panic surfaces as `RailsloshError`, never as a panic.
+#[pyfunction]
+fn _panic_for_test(py: Python<'_>) -> PyResult<()> {
+    compute(py, || -> Result<(), AncfError> { panic!("deliberate test panic") })
+}
+
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add("RailsloshError", m.py().get_type::<RailsloshError>())?;
+    m.add_class::<PyFluidMesh>()?;
+    m.add_class::<PyFluid>()?;
+    m.add_class::<PyFluidBody>()?;
+    m.add_function(wrap_pyfunction!(box_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(cylinder_tank, m)?)?;
+    m.add_function(wrap_pyfunction!(elliptic_cylinder, m)?)?;
+    m.add_function(wrap_pyfunction!(validation_cases, m)?)?;
+    m.add_function(wrap_pyfunction!(run_validation, m)?)?;
+    m.add_function(wrap_pyfunction!(_panic_for_test, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,5 @@
+import sys
+
+from railslosh.cli import main
+
+sys.exit(main())
