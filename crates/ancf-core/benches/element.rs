@@ -1,1 +1,91 @@
-fn main() {}
+//! `cargo bench -p ancf-core --bench element`: cost of the ANCF brick force kernels.
+//!
+//! For each quadrature setting it reports, on ONE thread (a 1-thread rayon pool):
+//! - batched internal force (two GEMMs per chunk + point-wise stress): ns/element, GFLOP/s;
+//! - the scalar per-element force path, for comparison in the same run;
+//! - force + exact Jacobians (K and C, 96×96 each): ns/element, GFLOP/s.
+//!
+//! Timings are medians of repeated runs. The flop model (per element, NPT = points):
+//! GEMMs 2·3NPT·32·6 + 2·32·3NPT·3, plus ≈350 flops per viscous point and ≈250 per
+//! penalty point for the stress update; the Jacobian adds ≈127 kflop per point
+//! (two 96×96 rank-9 accumulations and 18 directional derivatives).
+//! Pass a filter argument (e.g. `cargo bench --bench element -- quick`) for fewer repetitions.
+
+use std::hint::black_box;
+use std::time::Instant;
+
+use ancf_core::FluidBody;
+use ancf_core::constitutive::{Fluid, Rheology};
+use ancf_core::element::QuadratureOptions;
+use ancf_core::mesh::box_mesh;
+use ancf_core::validate::Rng;
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(|a, b| a.partial_cmp(b).unwrap());
+    v[v.len() / 2]
+}
+
+fn time<F: FnMut()>(reps: usize, mut f: F) -> f64 {
+    f(); // warm-up
+    median(
+        (0..reps)
+            .map(|_| {
+                let t = Instant::now();
+                f();
+                t.elapsed().as_secs_f64()
+            })
+            .collect(),
+    )
+}
+
+fn main() {
+    let quick = std::env::args().any(|a| a == "quick");
+    let reps = if quick { 5 } else { 21 };
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+    let mesh = box_mesh([0.0; 3], [2.0, 1.0, 1.0], [16, 8, 8]).unwrap(); // 1024 elements
+    let nel = mesh.n_elements() as f64;
+    println!("ANCF brick kernels, {} elements, 1 thread, median of {reps} runs", mesh.n_elements());
+    println!(
+        "{:<30} {:>6} {:>14} {:>9} {:>14} {:>14} {:>13} {:>9}",
+        "fluid", "rule", "force ns/el", "GFLOP/s", "scalar ns/el", "batch speedup", "f+jac us/el", "GFLOP/s"
+    );
+    let fluids = [
+        Fluid::new(850.0, Rheology::Newtonian { viscosity: 0.005 }, 1.25e7).unwrap(),
+        Fluid::new(1000.0, Rheology::Oldroyd { viscosity: 100.0, yield_stress: 100.0, elastic_modulus: None }, 1.5e7)
+            .unwrap(),
+    ];
+    for fluid in fluids {
+        for (nv, np) in [(3, 1), (3, 2), (4, 2), (4, 3)] {
+            let body =
+                FluidBody::new(mesh.clone(), fluid, QuadratureOptions { viscous: nv, penalty: np, mass: 4 }).unwrap();
+            let mut rng = Rng::new(1);
+            let e: Vec<f64> = body.reference_coordinates().iter().map(|x| x + 0.002 * rng.uniform()).collect();
+            let v: Vec<f64> = e.iter().map(|_| 0.1 * rng.uniform()).collect();
+            let mut f = vec![0.0; body.n_coords()];
+            let (t_b, t_s, t_j) = pool.install(|| {
+                let t_b = time(reps, || body.internal_forces(black_box(&e), black_box(&v), &mut f).unwrap());
+                let t_s =
+                    time(reps.min(7), || body.internal_forces_scalar(black_box(&e), black_box(&v), &mut f).unwrap());
+                let t_j = time(3, || {
+                    black_box(body.element_jacobians(black_box(&e), black_box(&v)).unwrap());
+                });
+                (t_b, t_s, t_j)
+            });
+            let (pv, pp) = ((nv * nv * nv) as f64, (np * np * np) as f64);
+            let npt = pv + pp;
+            let flops_f = 2.0 * 3.0 * npt * 32.0 * 6.0 + 2.0 * 32.0 * 3.0 * npt * 3.0 + 350.0 * pv + 250.0 * pp;
+            let flops_j = flops_f + 127_000.0 * npt;
+            println!(
+                "{:<30} {:>6} {:>14.0} {:>9.2} {:>14.0} {:>13.2}x {:>13.1} {:>9.2}",
+                format!("{} (rho {})", fluid.rheology.name(), fluid.density),
+                format!("{nv}^3+{np}^3"),
+                1e9 * t_b / nel,
+                flops_f * nel / t_b / 1e9,
+                1e9 * t_s / nel,
+                t_s / t_b,
+                1e6 * t_j / nel,
+                flops_j * nel / t_j / 1e9,
+            );
+        }
+    }
+}
