@@ -74,7 +74,7 @@ class FluidBody:
         mesh: FluidMesh,
         fluid: Fluid,
         viscous_points: int = 3,
-        penalty_points: int = 2,
+        penalty_points: int = 3,
         mass_points: int = 4,
     ) -> None: ...
     @property

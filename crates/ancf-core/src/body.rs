@@ -341,7 +341,7 @@ pub fn scalar_index(nodes: &[usize; 8], a: usize) -> usize {
     4 * nodes[a / 4] + a % 4
 }
 
-fn gather_compact(nodes_ref: &[[f64; COORDS_PER_NODE]], nodes: &[usize; 8]) -> Compact {
+pub(crate) fn gather_compact(nodes_ref: &[[f64; COORDS_PER_NODE]], nodes: &[usize; 8]) -> Compact {
     let mut c = [[0.0; 3]; N_SHAPE];
     for a in 0..N_SHAPE {
         let n = &nodes_ref[nodes[a / 4]];

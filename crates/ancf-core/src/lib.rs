@@ -21,11 +21,13 @@
 
 pub mod body;
 pub mod constitutive;
+pub mod contact;
 pub mod element;
 pub mod error;
 pub mod mesh;
 pub mod quadrature;
 pub mod shape;
+pub mod tank;
 pub mod validate;
 
 pub use body::FluidBody;

@@ -10,5 +10,6 @@
 
 pub mod integrator;
 pub mod profile;
+pub mod slosh;
 pub mod track;
 pub mod wheel_rail;

@@ -255,7 +255,7 @@ struct PyFluidBody {
 #[pymethods]
 impl PyFluidBody {
     #[new]
-    #[pyo3(signature = (mesh, fluid, viscous_points=3, penalty_points=2, mass_points=4))]
+    #[pyo3(signature = (mesh, fluid, viscous_points=3, penalty_points=3, mass_points=4))]
     fn new(
         py: Python<'_>,
         mesh: &PyFluidMesh,

@@ -1,0 +1,200 @@
+//! Typed errors of the integrator and of the systems it advances.
+
+use std::fmt;
+
+/// Location of one unknown of the KKT system `[Δa; −Δλ]`.
+///
+/// The first `n` unknowns are accelerations of generalized coordinates, the next `m`
+/// are Lagrange multipliers of constraints.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum KktIndex {
+    /// Acceleration of generalized coordinate `i`.
+    Coordinate(usize),
+    /// Multiplier of constraint `k`.
+    Constraint(usize),
+}
+
+impl KktIndex {
+    /// Maps a raw KKT row/column index to a coordinate or a constraint.
+    pub fn from_raw(index: usize, n_coords: usize) -> Self {
+        if index < n_coords { Self::Coordinate(index) } else { Self::Constraint(index - n_coords) }
+    }
+}
+
+impl fmt::Display for KktIndex {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Coordinate(i) => write!(f, "coordinate {i}"),
+            Self::Constraint(k) => write!(f, "constraint {k}"),
+        }
+    }
+}
+
+/// Error returned by a [`MechanicalSystem`](super::MechanicalSystem) callback.
+///
+/// Systems say *which* part of the model failed; the integrator adds *when*
+/// (time, step size) by wrapping it in [`IntegratorError::System`].
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SystemError {
+    /// A finite element (e.g. an ANCF fluid element) could not be evaluated.
+    #[error("element {index}: {reason}")]
+    Element {
+        /// Element index in the system's own numbering.
+        index: usize,
+        /// Human-readable cause (e.g. "inverted element, det J = -0.2").
+        reason: String,
+    },
+    /// A constraint (joint, normalization, contact) could not be evaluated.
+    #[error("constraint {index}: {reason}")]
+    Constraint {
+        /// Constraint index in `0..n_constraints()`.
+        index: usize,
+        /// Human-readable cause.
+        reason: String,
+    },
+    /// A rigid or flexible body could not be evaluated.
+    #[error("body {index}: {reason}")]
+    Body {
+        /// Body index in the system's own numbering.
+        index: usize,
+        /// Human-readable cause.
+        reason: String,
+    },
+    /// Any other model failure.
+    #[error("{0}")]
+    Other(String),
+}
+
+/// Which quantity was found non-finite (NaN or ±inf).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Quantity {
+    /// Initial positions `q0`.
+    InitialPositions,
+    /// Initial velocities `v0`.
+    InitialVelocities,
+    /// Mass-matrix values.
+    Mass,
+    /// Generalized forces `Q`.
+    Forces,
+    /// Force Jacobian `∂Q/∂q`.
+    ForceJacobianQ,
+    /// Force Jacobian `∂Q/∂v`.
+    ForceJacobianV,
+    /// Constraint residuals `C`.
+    Constraints,
+    /// Constraint Jacobian `C_q`.
+    ConstraintJacobian,
+    /// Constraint acceleration right-hand side (consistent initialization).
+    ConstraintAccelerationRhs,
+}
+
+impl fmt::Display for Quantity {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let s = match self {
+            Self::InitialPositions => "initial positions",
+            Self::InitialVelocities => "initial velocities",
+            Self::Mass => "mass matrix",
+            Self::Forces => "generalized forces Q",
+            Self::ForceJacobianQ => "force Jacobian dQ/dq",
+            Self::ForceJacobianV => "force Jacobian dQ/dv",
+            Self::Constraints => "constraint residual C",
+            Self::ConstraintJacobian => "constraint Jacobian C_q",
+            Self::ConstraintAccelerationRhs => "constraint acceleration right-hand side",
+        };
+        f.write_str(s)
+    }
+}
+
+/// Errors of the HHT-α integrator. Each variant says where (time, step size, index)
+/// and why.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum IntegratorError {
+    /// A parameter is outside its admissible range.
+    #[error("invalid parameter `{field}` = {value}: allowed {allowed}")]
+    InvalidParameter {
+        /// Parameter name.
+        field: &'static str,
+        /// Rejected value.
+        value: f64,
+        /// Admissible range, in words.
+        allowed: &'static str,
+    },
+    /// The system's dimensions or sparsity pattern are inconsistent.
+    #[error("invalid system: {what}")]
+    InvalidSystem {
+        /// What is inconsistent.
+        what: String,
+    },
+    /// A system callback returned NaN or ±inf.
+    #[error("non-finite {what} at t = {t} s (entry {index})")]
+    NonFinite {
+        /// Time at which the callback was evaluated, s.
+        t: f64,
+        /// Which quantity.
+        what: Quantity,
+        /// Index of the first non-finite entry (pattern order for matrices).
+        index: usize,
+    },
+    /// The KKT matrix is singular: a pivot could not be found, or the solution is
+    /// non-finite / fails the residual check. Usually redundant or inconsistent
+    /// constraints.
+    #[error(
+        "singular KKT matrix at t = {t} s (h = {h} s): {}{}",
+        match pivot_step { Some(p) => format!("no pivot at elimination step {p}"), None => String::from("numerically singular") },
+        match unknown { Some(u) => format!(", first bad unknown: {u}"), None => String::new() }
+    )]
+    SingularMatrix {
+        /// Start time of the step (or initial time), s.
+        t: f64,
+        /// Step size, s (0 for the initial acceleration solve).
+        h: f64,
+        /// Elimination step at which faer found no pivot (permuted order), if known.
+        pivot_step: Option<usize>,
+        /// First unknown whose solution was non-finite, if known.
+        unknown: Option<KktIndex>,
+    },
+    /// Newton iterations did not converge (and the step could not be reduced).
+    #[error(
+        "Newton iteration did not converge at t = {t} s, h = {h} s after {iterations} iterations \
+         (last WRMS correction {correction:e}, rate {rate:e})"
+    )]
+    NewtonDivergence {
+        /// Start time of the step, s.
+        t: f64,
+        /// Step size of the last attempt, s.
+        h: f64,
+        /// Newton iterations of the last attempt.
+        iterations: usize,
+        /// Weighted RMS norm of the last correction (converged when < 1).
+        correction: f64,
+        /// Last estimated convergence rate (NaN if fewer than two iterations).
+        rate: f64,
+    },
+    /// Adaptive stepping needed a step below `h_min`.
+    #[error("step size {h} s below h_min = {h_min} s at t = {t} s")]
+    StepTooSmall {
+        /// Time at which the step failed, s.
+        t: f64,
+        /// Step size that would have been needed, s.
+        h: f64,
+        /// Configured minimum step size, s.
+        h_min: f64,
+    },
+    /// The sparse linear solver failed for a reason other than singularity
+    /// (out of memory, index overflow).
+    #[error("linear solver failure at t = {t} s: {message}")]
+    LinearSolver {
+        /// Time, s.
+        t: f64,
+        /// faer's error, formatted.
+        message: String,
+    },
+    /// A system callback failed.
+    #[error("system evaluation failed at t = {t} s: {source}")]
+    System {
+        /// Time at which the callback was evaluated, s.
+        t: f64,
+        /// The system's error, naming the element/constraint/body.
+        source: SystemError,
+    },
+}

@@ -1,0 +1,243 @@
+//! Sparse KKT assembly and faer LU with a symbolic factorization computed once.
+//!
+//! The KKT matrix of size `(n + m) × (n + m)` is
+//!
+//! ```text
+//! [ c_m M − c_v ∂Q/∂v − c_q ∂Q/∂q   C_qᵀ ]
+//! [ C_q                             0    ]
+//! ```
+//!
+//! Its pattern (the union of the dynamics pattern, the diagonal, `C_q` and `C_qᵀ`) is
+//! fixed when the solver is built; [`KktSolver::assemble`] writes values through a
+//! precomputed map into the CSC value array, so no allocation happens per Newton
+//! iteration on our side. (faer's high-level `Lu::try_new_with_symbolic` and
+//! `solve_in_place` allocate their own scratch; see the TODO in [`KktSolver`].)
+
+use faer::MatMut;
+use faer::linalg::solvers::Solve;
+use faer::sparse::linalg::LuError;
+use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
+use faer::sparse::{Pair, SparseColMat, SymbolicSparseColMat};
+
+use super::error::KktIndex;
+use super::system::SparsityPattern;
+
+/// Why a factorization or solve failed (converted to an
+/// [`IntegratorError`](super::IntegratorError) by the caller, who knows `t` and `h`).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum LinearFailure {
+    /// faer found no pivot (structurally singular) at this elimination step.
+    NoPivot(usize),
+    /// Solution non-finite or residual check failed; first bad unknown if any.
+    Numeric(Option<KktIndex>),
+    /// Allocation / index overflow inside faer.
+    Generic(String),
+}
+
+/// Sparse KKT matrix with its symbolic LU and the latest numeric LU.
+///
+/// TODO(perf): use faer's low-level `factorize_numeric_lu` with a persistent
+/// `NumericLu` and `MemBuffer` to make refactorizations allocation-free.
+pub(crate) struct KktSolver {
+    n: usize,
+    m: usize,
+    matrix: SparseColMat<usize, f64>,
+    /// CSC value position of each `dynamics` pattern entry.
+    dyn_pos: Vec<usize>,
+    /// CSC value positions of each `C_q` entry: `(n + k, j)` and `(j, n + k)`.
+    cq_pos: Vec<(usize, usize)>,
+    symbolic: SymbolicLu<usize>,
+    lu: Option<Lu<usize, f64>>,
+    /// Copy of the right-hand side for the residual check.
+    rhs_copy: Vec<f64>,
+    /// Residual / refinement buffer.
+    work: Vec<f64>,
+    /// Relative residual tolerance of the solve check.
+    residual_tol: f64,
+    /// Largest absolute matrix entry at the last factorization.
+    a_max: f64,
+}
+
+impl KktSolver {
+    /// Builds the pattern and the symbolic LU. Pattern entries must already be
+    /// validated against `n` and `m`.
+    pub(crate) fn new(n: usize, m: usize, pattern: &SparsityPattern, residual_tol: f64) -> Result<Self, LinearFailure> {
+        let dim = n + m;
+        let mut pairs: Vec<Pair<usize, usize>> =
+            Vec::with_capacity(pattern.dynamics.len() + n + 2 * pattern.constraints.len());
+        pairs.extend(pattern.dynamics.iter().map(|&(row, col)| Pair { row, col }));
+        pairs.extend((0..n).map(|i| Pair { row: i, col: i }));
+        for &(k, j) in &pattern.constraints {
+            pairs.push(Pair { row: n + k, col: j });
+            pairs.push(Pair { row: j, col: n + k });
+        }
+        let (symbolic, _argsort) = SymbolicSparseColMat::try_new_from_indices(dim, dim, &pairs)
+            .map_err(|e| LinearFailure::Generic(format!("{e:?}")))?;
+        let pos = |row: usize, col: usize| -> usize {
+            let start = symbolic.col_ptr()[col];
+            let rows = &symbolic.row_idx()[start..symbolic.col_ptr()[col + 1]];
+            // The pattern contains (row, col) by construction.
+            start + rows.binary_search(&row).unwrap_or(0)
+        };
+        let dyn_pos = pattern.dynamics.iter().map(|&(r, c)| pos(r, c)).collect();
+        let cq_pos = pattern.constraints.iter().map(|&(k, j)| (pos(n + k, j), pos(j, n + k))).collect();
+        let nnz = symbolic.row_idx().len();
+        let matrix = SparseColMat::new(symbolic, vec![0.0; nnz]);
+        let symbolic_lu =
+            SymbolicLu::try_new(matrix.symbolic()).map_err(|e| LinearFailure::Generic(format!("{e:?}")))?;
+        Ok(Self {
+            n,
+            m,
+            matrix,
+            dyn_pos,
+            cq_pos,
+            symbolic: symbolic_lu,
+            lu: None,
+            rhs_copy: vec![0.0; dim],
+            work: vec![0.0; dim],
+            residual_tol,
+            a_max: 0.0,
+        })
+    }
+
+    /// Number of structural non-zeros of the KKT matrix.
+    pub(crate) fn nnz(&self) -> usize {
+        self.matrix.val().len()
+    }
+
+    /// Writes `c_m M − c_v Dv − c_q Dq` and `C_q`, `C_qᵀ` into the matrix values.
+    pub(crate) fn assemble(
+        &mut self,
+        mass: &[f64],
+        dq: &[f64],
+        dv: &[f64],
+        cq: &[f64],
+        (c_m, c_v, c_q): (f64, f64, f64),
+    ) {
+        let vals = self.matrix.val_mut();
+        vals.fill(0.0);
+        for (k, &p) in self.dyn_pos.iter().enumerate() {
+            vals[p] += c_m * mass[k] - c_v * dv[k] - c_q * dq[k];
+        }
+        for (k, &(p, pt)) in self.cq_pos.iter().enumerate() {
+            vals[p] += cq[k];
+            vals[pt] += cq[k];
+        }
+    }
+
+    /// Numeric LU of the current values, reusing the symbolic factorization.
+    pub(crate) fn factorize(&mut self) -> Result<(), LinearFailure> {
+        self.lu = None;
+        if self.matrix.val().iter().any(|v| !v.is_finite()) {
+            return Err(LinearFailure::Numeric(None));
+        }
+        self.a_max = inf_norm(self.matrix.val());
+        // faer 0.24 can panic on some zero pivots (faer-rs issue #232); turn that into
+        // an error instead of unwinding through the integrator.
+        let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            Lu::try_new_with_symbolic(self.symbolic.clone(), self.matrix.as_ref())
+        }));
+        match result {
+            Ok(Ok(lu)) => {
+                self.lu = Some(lu);
+                Ok(())
+            }
+            Ok(Err(LuError::SymbolicSingular { index })) => Err(LinearFailure::NoPivot(index)),
+            Ok(Err(LuError::Generic(e))) => Err(LinearFailure::Generic(format!("{e:?}"))),
+            Err(_) => Err(LinearFailure::Numeric(None)),
+        }
+    }
+
+    /// Solves `A x = b` in place (`rhs` holds `b` on entry, `x` on exit), checks
+    /// finiteness and the relative residual, and does up to one step of iterative
+    /// refinement if the residual is too large.
+    pub(crate) fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearFailure> {
+        let dim = self.n + self.m;
+        let Some(lu) = self.lu.as_ref() else {
+            return Err(LinearFailure::Numeric(None));
+        };
+        self.rhs_copy.copy_from_slice(rhs);
+        lu.solve_in_place(MatMut::from_column_major_slice_mut(rhs, dim, 1));
+        for refinement in 0..2 {
+            if let Some(i) = rhs.iter().position(|v| !v.is_finite()) {
+                return Err(LinearFailure::Numeric(Some(KktIndex::from_raw(i, self.n))));
+            }
+            // work = b − A x
+            self.work.copy_from_slice(&self.rhs_copy);
+            let (sym, vals) = self.matrix.parts();
+            let (col_ptr, row_idx) = (sym.col_ptr(), sym.row_idx());
+            for j in 0..dim {
+                let xj = rhs[j];
+                let range = col_ptr[j]..col_ptr[j + 1];
+                for (&i, &a) in row_idx[range.clone()].iter().zip(&vals[range]) {
+                    self.work[i] -= a * xj;
+                }
+            }
+            let r = inf_norm(&self.work);
+            let scale = self.a_max * inf_norm(rhs) + inf_norm(&self.rhs_copy);
+            if r <= self.residual_tol * scale || r == 0.0 {
+                return Ok(());
+            }
+            if refinement == 1 {
+                break;
+            }
+            lu.solve_in_place(MatMut::from_column_major_slice_mut(&mut self.work, dim, 1));
+            for (x, d) in rhs.iter_mut().zip(&self.work) {
+                *x += d;
+            }
+        }
+        Err(LinearFailure::Numeric(None))
+    }
+}
+
+fn inf_norm(x: &[f64]) -> f64 {
+    x.iter().fold(0.0_f64, |m, v| m.max(v.abs()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// 3 coordinates, 1 constraint: checks value mapping against a dense product and
+    /// the solve.
+    #[test]
+    fn assembly_and_solve_match_dense() {
+        let pattern = SparsityPattern {
+            dynamics: vec![(0, 0), (1, 1), (2, 2), (0, 1), (1, 0), (2, 1), (2, 2)],
+            constraints: vec![(0, 0), (0, 2)],
+        };
+        let mut kkt = KktSolver::new(3, 1, &pattern, 1e-12).unwrap();
+        let mass = [2.0, 3.0, 4.0, 0.0, 0.0, 0.0, 0.0];
+        let dq = [-1.0, -1.0, -1.0, 0.5, 0.5, 0.25, -1.0];
+        let dv = [-0.1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+        let cq = [1.0, -2.0];
+        let (cm, cv, cqc) = (1.25, 0.1, 0.01);
+        kkt.assemble(&mass, &dq, &dv, &cq, (cm, cv, cqc));
+        // Dense reference, duplicates summed.
+        let mut a = [[0.0; 4]; 4];
+        for (k, &(i, j)) in pattern.dynamics.iter().enumerate() {
+            a[i][j] += cm * mass[k] - cv * dv[k] - cqc * dq[k];
+        }
+        for (k, &(r, c)) in pattern.constraints.iter().enumerate() {
+            a[3 + r][c] += cq[k];
+            a[c][3 + r] += cq[k];
+        }
+        let x_true = [1.0, -2.0, 0.5, 3.0];
+        let mut b: Vec<f64> = (0..4).map(|i| (0..4).map(|j| a[i][j] * x_true[j]).sum()).collect();
+        kkt.factorize().unwrap();
+        kkt.solve_in_place(&mut b).unwrap();
+        for (x, t) in b.iter().zip(&x_true) {
+            assert!((x - t).abs() < 1e-12, "{x} vs {t}");
+        }
+        assert_eq!(kkt.nnz(), 3 + 3 + 4);
+    }
+
+    #[test]
+    fn zero_constraint_row_is_structurally_singular() {
+        let pattern = SparsityPattern { dynamics: vec![(0, 0), (1, 1)], constraints: vec![(0, 0)] };
+        // Constraint 1 has no Jacobian entries.
+        let mut kkt = KktSolver::new(2, 2, &pattern, 1e-12).unwrap();
+        kkt.assemble(&[1.0, 1.0], &[0.0; 2], &[0.0; 2], &[1.0], (1.0, 0.0, 0.0));
+        assert!(matches!(kkt.factorize(), Err(LinearFailure::NoPivot(_))));
+    }
+}

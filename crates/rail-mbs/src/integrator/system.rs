@@ -1,0 +1,140 @@
+//! The [`MechanicalSystem`] trait: what the integrator needs from a model.
+
+use super::error::SystemError;
+
+/// Fixed sparsity pattern of a [`MechanicalSystem`], declared once.
+///
+/// * `dynamics` lists `(row, col)` entries of the `n × n` matrices `M`, `∂Q/∂q` and
+///   `∂Q/∂v` — one shared pattern, the union of the three. Mass and Jacobian values
+///   are written **in this order**; entries a matrix does not use are written as 0.
+/// * `constraints` lists `(row, col)` entries of the `m × n` constraint Jacobian
+///   `C_q` (row = constraint index, col = coordinate index); its values are written
+///   in this order.
+///
+/// Duplicate entries are allowed and summed. Entries that are sometimes zero (e.g.
+/// wheel/rail contacts that switch on and off) **must stay in the pattern** as
+/// explicit zeros: the symbolic LU factorization is computed once from it.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct SparsityPattern {
+    /// `(row, col)` entries of `M`, `∂Q/∂q`, `∂Q/∂v` (union), each in `0..n`.
+    pub dynamics: Vec<(usize, usize)>,
+    /// `(constraint, coordinate)` entries of `C_q`, in `0..m × 0..n`.
+    pub constraints: Vec<(usize, usize)>,
+}
+
+impl SparsityPattern {
+    /// Dense-diagonal helper: the pattern `{(i, i)}` for `i in 0..n`, no constraints.
+    pub fn diagonal(n: usize) -> Self {
+        Self { dynamics: (0..n).map(|i| (i, i)).collect(), constraints: Vec::new() }
+    }
+}
+
+/// A constrained mechanical system in index-3 form,
+///
+/// ```text
+/// M(q) a = Q(t, q, v) + C_q(q, t)ᵀ λ,      v = q̇,  a = v̇,
+/// C(q, t) = 0,
+/// ```
+///
+/// with `n` generalized coordinates (`q`, `v`, `a` all have length `n`) and `m`
+/// holonomic constraints. `Q` collects **applied minus internal** forces (gravity,
+/// springs, contact, elastic forces of ANCF elements enter with a minus sign), and
+/// `C_qᵀ λ` is the constraint force (so `λ` is a force for `C = x − x₀`).
+///
+/// Rigid bodies with Euler parameters use `ṗ` as velocities (so `q` and `v` have the
+/// same length) and add the normalization `pᵀp − 1 = 0` as a constraint. ANCF bodies
+/// have a constant mass matrix: return `true` from [`mass_is_constant`] and the
+/// integrator evaluates [`mass`] once.
+///
+/// All matrix values are written into caller-provided slices in the order of
+/// [`pattern`]; the slices are zeroed by the caller before each call. Callbacks return
+/// a [`SystemError`] naming the failing element/constraint; the integrator adds the
+/// time. Methods take `&mut self` so that models can cache (e.g. contact search
+/// results between [`forces`] and [`force_jacobians`] at the same state).
+///
+/// [`mass_is_constant`]: MechanicalSystem::mass_is_constant
+/// [`mass`]: MechanicalSystem::mass
+/// [`pattern`]: MechanicalSystem::pattern
+/// [`forces`]: MechanicalSystem::forces
+/// [`force_jacobians`]: MechanicalSystem::force_jacobians
+pub trait MechanicalSystem {
+    /// Number of generalized coordinates `n` (= number of velocities).
+    fn n_coords(&self) -> usize;
+
+    /// Number of holonomic constraints `m`.
+    fn n_constraints(&self) -> usize {
+        0
+    }
+
+    /// The fixed sparsity pattern. Called once, when the integrator is built.
+    fn pattern(&self) -> SparsityPattern;
+
+    /// Whether `M` is independent of `q` (ANCF elements, point masses). If `true`,
+    /// [`mass`](MechanicalSystem::mass) is called once and cached.
+    fn mass_is_constant(&self) -> bool {
+        false
+    }
+
+    /// Mass-matrix values at `q`, in `pattern().dynamics` order, kg (or kg·m² …).
+    fn mass(&mut self, q: &[f64], values: &mut [f64]) -> Result<(), SystemError>;
+
+    /// Generalized forces `Q(t, q, v)` (applied minus internal), length `n`.
+    fn forces(&mut self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) -> Result<(), SystemError>;
+
+    /// Force Jacobians `∂Q/∂q` (into `dq`) and `∂Q/∂v` (into `dv`), both in
+    /// `pattern().dynamics` order. For a linear spring `Q = −k x` write `−k`.
+    fn force_jacobians(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        dq: &mut [f64],
+        dv: &mut [f64],
+    ) -> Result<(), SystemError>;
+
+    /// Constraint residuals `C(q, t)`, length `m`. Default: no constraints.
+    fn constraints(&mut self, t: f64, q: &[f64], out: &mut [f64]) -> Result<(), SystemError> {
+        let _ = (t, q, out);
+        Ok(())
+    }
+
+    /// Constraint Jacobian `C_q` values in `pattern().constraints` order.
+    fn constraint_jacobian(&mut self, t: f64, q: &[f64], values: &mut [f64]) -> Result<(), SystemError> {
+        let _ = (t, q, values);
+        Ok(())
+    }
+
+    /// Optional geometric stiffness of the constraint forces: **add**
+    /// `∂(C_qᵀ λ)/∂q` into `dq` (pattern order) and return `Ok(true)`.
+    ///
+    /// The default returns `Ok(false)`: the term is neglected in the Newton matrix,
+    /// which then converges linearly instead of quadratically (the converged
+    /// solution is unchanged).
+    fn constraint_force_jacobian(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        lambda: &[f64],
+        dq: &mut [f64],
+    ) -> Result<bool, SystemError> {
+        let _ = (t, q, lambda, dq);
+        Ok(false)
+    }
+
+    /// Optional exact right-hand side of the acceleration-level constraints,
+    /// `γ = −(C_q v)_q v − 2 C_qt v − C_tt`, so that `C_q a = γ`. Return `Ok(true)` if
+    /// written. Used only for the consistent initial acceleration.
+    ///
+    /// The default returns `Ok(false)`; the integrator then uses the central second
+    /// difference of `s ↦ C(q + s v, t + s)` at `s = 0`, which is exactly `−γ`.
+    fn constraint_acceleration_rhs(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        out: &mut [f64],
+    ) -> Result<bool, SystemError> {
+        let _ = (t, q, v, out);
+        Ok(false)
+    }
+}

@@ -1,0 +1,146 @@
+//! Fluid sloshing in a rigid tank with prescribed motion: the system, the run driver and
+//! the recorded outputs.
+//!
+//! Data flow: [`SloshSystem`] (fluid body + wall contact + motion) → [`SloshRun`] (HHT
+//! integrator loop) → [`SloshRecord`] (time series, recorded every step).
+
+pub mod motion;
+pub mod system;
+
+pub use motion::{PiecewiseAcceleration, PrescribedMotion, TankState};
+pub use system::{SloshFrame, SloshSystem};
+
+use nalgebra::Vector3;
+
+use crate::integrator::{Hht, HhtParams, IntegratorError, Stats};
+
+/// Time series recorded by a slosh run. Loads are the force and moment the fluid exerts on
+/// the tank (through wall and bulkhead contact), moments about the tank origin.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SloshRecord {
+    /// Time (s).
+    pub t: Vec<f64>,
+    /// Fluid force on the tank, tank frame (N).
+    pub force_tank: Vec<[f64; 3]>,
+    /// Fluid moment on the tank about its origin, tank frame (N·m).
+    pub moment_tank: Vec<[f64; 3]>,
+    /// Fluid force on the tank, global frame (N).
+    pub force_global: Vec<[f64; 3]>,
+    /// Fluid moment on the tank about its origin, global frame (N·m).
+    pub moment_global: Vec<[f64; 3]>,
+    /// Fluid centre of mass in the tank frame (m).
+    pub com_tank: Vec<[f64; 3]>,
+    /// Fluid volume ∫J dV₀ (m³).
+    pub volume: Vec<f64>,
+    /// Kinetic energy (J), inertial velocities.
+    pub kinetic_energy: Vec<f64>,
+    /// Gravitational potential energy (J).
+    pub potential_energy: Vec<f64>,
+    /// Newton iterations of the step.
+    pub newton_iterations: Vec<usize>,
+    /// Largest wall penetration (m).
+    pub max_penetration: Vec<f64>,
+}
+
+/// A slosh run: the integrator, its system and the record.
+pub struct SloshRun {
+    /// The integrator (owns the system).
+    pub hht: Hht<SloshSystem>,
+    /// Outputs so far.
+    pub record: SloshRecord,
+}
+
+/// A failed run: the error and everything recorded up to it.
+#[derive(Debug)]
+pub struct SloshFailure {
+    /// What went wrong, and when.
+    pub error: IntegratorError,
+    /// The record up to the last accepted step.
+    pub record: SloshRecord,
+}
+
+impl std::fmt::Display for SloshFailure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "slosh run failed after {} recorded steps: {}", self.record.t.len(), self.error)
+    }
+}
+
+impl SloshRun {
+    /// Start at t0 from the system's initial state (fluid moving rigidly with the tank).
+    pub fn new(system: SloshSystem, t0: f64, params: HhtParams) -> Result<Self, IntegratorError> {
+        let (q, v) = system.initial_state(t0);
+        let hht = Hht::new(system, t0, q, v, params)?;
+        let mut run = Self { hht, record: SloshRecord::default() };
+        run.record_state(0);
+        Ok(run)
+    }
+
+    /// Integrate to `t_end` with steps of (at most) `h`, recording every step.
+    pub fn run_to(&mut self, t_end: f64, h: f64) -> Result<(), Box<SloshFailure>> {
+        while t_end - self.hht.t() > 1e-12 * (1.0 + t_end.abs()) {
+            let h_step = h.min(t_end - self.hht.t());
+            match self.hht.step(h_step) {
+                Ok(info) => self.record_state(info.iterations),
+                Err(error) => return Err(Box::new(SloshFailure { error, record: self.record.clone() })),
+            }
+        }
+        Ok(())
+    }
+
+    /// Integrator statistics.
+    pub fn stats(&self) -> &Stats {
+        self.hht.stats()
+    }
+
+    fn record_state(&mut self, iterations: usize) {
+        let sys = self.hht.system();
+        let (t, q, v) = (self.hht.t(), self.hht.q(), self.hht.v());
+        let load = sys.contact_load(t, q, v);
+        let state = sys.motion.state(t);
+        let a = state.kinematics.rotation;
+        let (f, m) = (Vector3::from(load.force), Vector3::from(load.moment));
+        let (fk, mk, fg, mg) = match sys.frame {
+            SloshFrame::Inertial => (a.transpose() * f, a.transpose() * m, f, m),
+            SloshFrame::Tank => (f, m, a * f, a * m),
+        };
+        let body = &sys.body;
+        let com = Vector3::from(body.center_of_mass(q));
+        let com_tank = match sys.frame {
+            SloshFrame::Inertial => a.transpose() * (com - Vector3::from(state.kinematics.position)),
+            SloshFrame::Tank => com,
+        };
+        // inertial velocity and position for the energies
+        let (ke, pe) = match sys.frame {
+            SloshFrame::Inertial => (body.kinetic_energy(v), body.potential_energy(q, sys.gravity)),
+            SloshFrame::Tank => {
+                let (w, rt, vt) = (
+                    Vector3::from(state.kinematics.angular_velocity),
+                    Vector3::from(state.kinematics.position),
+                    Vector3::from(state.kinematics.velocity),
+                );
+                let mut qi = vec![0.0; q.len()];
+                let mut vi = vec![0.0; q.len()];
+                for s in 0..q.len() / 3 {
+                    let x = a * Vector3::new(q[3 * s], q[3 * s + 1], q[3 * s + 2]);
+                    let xd = a * Vector3::new(v[3 * s], v[3 * s + 1], v[3 * s + 2]) + w.cross(&x);
+                    let (p, pd) = if s % 4 == 0 { (x + rt, xd + vt) } else { (x, xd) };
+                    qi[3 * s..3 * s + 3].copy_from_slice(p.as_slice());
+                    vi[3 * s..3 * s + 3].copy_from_slice(pd.as_slice());
+                }
+                (body.kinetic_energy(&vi), body.potential_energy(&qi, sys.gravity))
+            }
+        };
+        let r = &mut self.record;
+        r.t.push(t);
+        r.force_tank.push(fk.into());
+        r.moment_tank.push(mk.into());
+        r.force_global.push(fg.into());
+        r.moment_global.push(mg.into());
+        r.com_tank.push(com_tank.into());
+        r.volume.push(body.volume(q));
+        r.kinetic_energy.push(ke);
+        r.potential_energy.push(pe);
+        r.newton_iterations.push(iterations);
+        r.max_penetration.push(load.max_penetration);
+    }
+}

@@ -1,0 +1,696 @@
+//! Contact-point search (ECF-A), normal and tangential contact forces.
+
+use std::sync::Arc;
+
+use nalgebra::{Matrix3, Matrix4, Vector3, Vector4};
+
+use super::ContactError;
+use super::creep::{CreepForces, CreepModel, Creepages, creep_forces};
+use super::hertz::{HertzConstants, Material, combined_modulus};
+use crate::profile::Profile;
+use crate::track::{Side, Track};
+
+/// Wheel geometry: profile, nominal radius and placement on the wheelset body.
+#[derive(Debug, Clone)]
+pub struct WheelGeometry {
+    /// Wheel profile (crate convention: `y` to the field side, `z` up, local radius
+    /// `r0 − z`).
+    pub profile: Profile,
+    /// Nominal rolling radius `r0` at the profile origin, m.
+    pub nominal_radius: f64,
+    /// Lateral distance from the body origin (wheelset centre) to the wheel profile
+    /// origin, m (positive; e.g. 0.75 m for S1002 with 1360 mm back-to-back).
+    pub profile_offset: f64,
+    /// Which wheel of the wheelset.
+    pub side: Side,
+}
+
+impl WheelGeometry {
+    /// Surface point and derivatives in the body frame at `(u, θ)`:
+    /// `[w, w_u, w_θ, w_uu, w_uθ, w_θθ]`.
+    fn surface(&self, u: f64, th: f64) -> [Vector3<f64>; 6] {
+        let sg = self.side.sign();
+        let (z, dz, ddz) = self.profile.eval(u);
+        let rho = self.nominal_radius - z;
+        let (rp, rpp) = (-dz, -ddz);
+        let (s, c) = th.sin_cos();
+        [
+            Vector3::new(rho * s, sg * (self.profile_offset + u), -rho * c),
+            Vector3::new(rp * s, sg, -rp * c),
+            Vector3::new(rho * c, 0.0, rho * s),
+            Vector3::new(rpp * s, 0.0, -rpp * c),
+            Vector3::new(rp * c, 0.0, rp * s),
+            Vector3::new(-rho * s, 0.0, rho * c),
+        ]
+    }
+}
+
+/// Where the rail runs.
+#[derive(Debug, Clone)]
+pub enum RailPath {
+    /// Straight rail along global `+X` (track frame = global frame, `s = X`), with a
+    /// fixed inward cant (rad).
+    Straight {
+        /// Inward cant of the rail, rad (e.g. `1/40`); zero for pre-canted profiles.
+        inward_cant: f64,
+    },
+    /// Rail following a [`Track`] (centreline frame, super-elevation, rail cant).
+    Track(Arc<Track>),
+}
+
+/// Rail geometry: profile, side and placement relative to the track centreline.
+#[derive(Debug, Clone)]
+pub struct RailGeometry {
+    /// Rail profile (crate convention: `y` to the field side, `z` up).
+    pub profile: Profile,
+    /// Which rail.
+    pub side: Side,
+    /// Lateral distance from the track centreline to the rail profile origin, m
+    /// (positive). See [`RailGeometry::offset_for_gauge`].
+    pub profile_offset: f64,
+    /// Height of the rail profile origin above the track centreline, m.
+    pub vertical_offset: f64,
+    /// Rail path.
+    pub path: RailPath,
+}
+
+impl RailGeometry {
+    /// Lateral offset of the profile origin such that the gauge point — the gauge-side
+    /// point `gauge_depth` below the highest point of `profile` — lies at `gauge/2` from
+    /// the centreline. Returns `None` when the profile does not reach that depth.
+    pub fn offset_for_gauge(profile: &Profile, gauge: f64, gauge_depth: f64) -> Option<f64> {
+        let (y_top, z_top) = profile.highest_point();
+        let yg = profile.crossing(y_top, -1.0, z_top - gauge_depth)?;
+        Some(0.5 * gauge - yg)
+    }
+
+    /// Frame (origin, rotation) of the rail profile at `s` and its first and second
+    /// derivatives with respect to `s`.
+    fn frame_derivs(&self, s: f64) -> RailFrameDerivs {
+        let sg = self.side.sign();
+        match &self.path {
+            RailPath::Straight { inward_cant } => {
+                let ang = sg * inward_cant;
+                RailFrameDerivs {
+                    origin: Vector3::new(s, sg * self.profile_offset, self.vertical_offset),
+                    rot: rot_x(ang),
+                    d_origin: Vector3::new(1.0, 0.0, 0.0),
+                    d_rot: Matrix3::zeros(),
+                    dd_origin: Vector3::zeros(),
+                    dd_rot: Matrix3::zeros(),
+                }
+            }
+            RailPath::Track(track) => {
+                let f = |s: f64| -> (Vector3<f64>, Matrix3<f64>) {
+                    let fr = track.frame(s);
+                    let o = fr.origin + fr.rotation * Vector3::new(0.0, sg * self.profile_offset, self.vertical_offset);
+                    let r = fr.rotation * rot_x(sg * track.rail_inward_cant(s, self.side));
+                    (o, r)
+                };
+                let h = 0.02;
+                let (o0, r0) = f(s);
+                let (op, rp) = f(s + h);
+                let (om, rm) = f(s - h);
+                RailFrameDerivs {
+                    origin: o0,
+                    rot: r0,
+                    d_origin: (op - om) / (2.0 * h),
+                    d_rot: (rp - rm) / (2.0 * h),
+                    dd_origin: (op - 2.0 * o0 + om) / (h * h),
+                    dd_rot: (rp - 2.0 * r0 + rm) / (h * h),
+                }
+            }
+        }
+    }
+
+    /// Rail surface point and derivatives at `(s, v)`: `[r, r_s, r_v, r_ss, r_sv, r_vv]`.
+    fn surface(&self, s: f64, v: f64) -> [Vector3<f64>; 6] {
+        let sg = self.side.sign();
+        let fd = self.frame_derivs(s);
+        let (z, dz, ddz) = self.profile.eval(v);
+        let p = Vector3::new(0.0, sg * v, z);
+        let pv = Vector3::new(0.0, sg, dz);
+        let pvv = Vector3::new(0.0, 0.0, ddz);
+        [
+            fd.origin + fd.rot * p,
+            fd.d_origin + fd.d_rot * p,
+            fd.rot * pv,
+            fd.dd_origin + fd.dd_rot * p,
+            fd.d_rot * pv,
+            fd.rot * pvv,
+        ]
+    }
+
+    /// Arc length on the rail path closest to a point (the wheel centre).
+    fn station(&self, p: &Vector3<f64>, hint: Option<f64>) -> Result<f64, ContactError> {
+        match &self.path {
+            RailPath::Straight { .. } => Ok(p.x),
+            RailPath::Track(t) => Ok(t.project(p, hint)?.s),
+        }
+    }
+}
+
+struct RailFrameDerivs {
+    origin: Vector3<f64>,
+    rot: Matrix3<f64>,
+    d_origin: Vector3<f64>,
+    d_rot: Matrix3<f64>,
+    dd_origin: Vector3<f64>,
+    dd_rot: Matrix3<f64>,
+}
+
+fn rot_x(a: f64) -> Matrix3<f64> {
+    let (s, c) = a.sin_cos();
+    Matrix3::new(1.0, 0.0, 0.0, 0.0, c, -s, 0.0, s, c)
+}
+
+/// Pose and velocity of the wheel(set) body.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WheelPose {
+    /// Body origin (wheelset centre on the axle axis), m (global).
+    pub position: Vector3<f64>,
+    /// Rotation body → global. The spin about the axle may be included or not (the wheel
+    /// is a surface of revolution).
+    pub rotation: Matrix3<f64>,
+    /// Velocity of the body origin, m/s (global).
+    pub velocity: Vector3<f64>,
+    /// Angular velocity, rad/s (global), including the spin about the axle.
+    pub angular_velocity: Vector3<f64>,
+}
+
+impl WheelPose {
+    /// A pose at rest.
+    pub fn at_rest(position: Vector3<f64>, rotation: Matrix3<f64>) -> Self {
+        Self { position, rotation, velocity: Vector3::zeros(), angular_velocity: Vector3::zeros() }
+    }
+}
+
+/// Settings of the contact search and force evaluation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactSettings {
+    /// Number of lateral samples of the scan over the wheel profile.
+    pub scan_points: usize,
+    /// Seeds from scan minima whose vertical gap exceeds this are ignored, m.
+    pub scan_gap_limit: f64,
+    /// Newton tolerance on the parameter update, m (and rad).
+    pub newton_tolerance: f64,
+    /// Maximum Newton iterations.
+    pub max_iterations: usize,
+    /// Two solutions closer than this in both lateral parameters are merged, m.
+    pub merge_distance: f64,
+    /// Scan every call (true, robust) or only when a warm start fails (false).
+    pub always_scan: bool,
+    /// Lower bound of the speed used to normalise creepages, m/s.
+    pub min_speed: f64,
+    /// Floor for the relative curvatures `A`, `B` (1/m) used by the Hertz solution.
+    /// Near-conformal points (e.g. a worn or S1002 throat against a rail corner) can
+    /// have a vanishing or negative relative curvature, for which Hertz theory has no
+    /// solution; they are evaluated with this floor instead (a documented
+    /// approximation — a non-Hertzian model would be needed there).
+    pub min_relative_curvature: f64,
+}
+
+impl Default for ContactSettings {
+    fn default() -> Self {
+        Self {
+            scan_points: 400,
+            scan_gap_limit: 2e-3,
+            newton_tolerance: 1e-11,
+            max_iterations: 40,
+            merge_distance: 1e-3,
+            always_scan: true,
+            min_speed: 0.05,
+            min_relative_curvature: 0.1,
+        }
+    }
+}
+
+/// How a contact point was obtained.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ContactMethod {
+    /// Newton–Raphson on `C(q) = 0` converged.
+    Newton,
+    /// Newton failed; the point is the refined minimum of the scan's vertical gap.
+    ScanFallback,
+}
+
+/// Geometric solution of one potential contact.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactGeometry {
+    /// Surface parameters `[s1r, s2r, s1w, s2w]` = `[s, v, u, θ]`.
+    pub params: [f64; 4],
+    /// Contact point on the rail, m (global).
+    pub point_rail: Vector3<f64>,
+    /// Contact point on the wheel, m (global).
+    pub point_wheel: Vector3<f64>,
+    /// Unit normal, out of the rail into the wheel.
+    pub normal: Vector3<f64>,
+    /// Rolling direction `e1` (unit, in the tangent plane, along the direction of
+    /// travel; `+x` of the body when at rest).
+    pub e1: Vector3<f64>,
+    /// `e2 = n × e1`.
+    pub e2: Vector3<f64>,
+    /// Penetration `δ = −r_wr·n̂`, m (positive = overlap).
+    pub penetration: f64,
+    /// Relative curvature `A` along `e1`, 1/m (`h = A x² + B y²`).
+    pub curvature_x: f64,
+    /// Relative curvature `B` along `e2`, 1/m.
+    pub curvature_y: f64,
+    /// How it was found.
+    pub method: ContactMethod,
+}
+
+/// A loaded contact point with forces.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactPoint {
+    /// Geometry.
+    pub geometry: ContactGeometry,
+    /// Hertz constants (stiffness and ellipse scaling).
+    pub hertz: HertzConstants,
+    /// Semi-axes `(a, b)` along `e1`, `e2`, m.
+    pub semi_axes: (f64, f64),
+    /// Penetration rate `δ̇`, m/s.
+    pub penetration_rate: f64,
+    /// Normal force (≥ 0), N, acting on the wheel along `+n`.
+    pub normal_force: f64,
+    /// Creepages.
+    pub creepages: Creepages,
+    /// Creep forces on the wheel (along `e1`, `e2`, about `n`).
+    pub creep: CreepForces,
+}
+
+impl ContactPoint {
+    /// Total contact force on the wheel, N (global). The rail receives the opposite.
+    pub fn force_on_wheel(&self) -> Vector3<f64> {
+        let g = &self.geometry;
+        g.normal * self.normal_force + g.e1 * self.creep.longitudinal + g.e2 * self.creep.lateral
+    }
+    /// Moment on the wheel about point `about` (e.g. the wheelset centre), N·m.
+    pub fn moment_on_wheel(&self, about: &Vector3<f64>) -> Vector3<f64> {
+        let g = &self.geometry;
+        let p = 0.5 * (g.point_rail + g.point_wheel);
+        (p - about).cross(&self.force_on_wheel()) + g.normal * self.creep.spin_moment
+    }
+    /// Contact point (midway between the surface points), m.
+    pub fn point(&self) -> Vector3<f64> {
+        0.5 * (self.geometry.point_rail + self.geometry.point_wheel)
+    }
+}
+
+/// One wheel against one rail: geometry, materials, laws and the warm-start state.
+#[derive(Debug, Clone)]
+pub struct WheelRailContact {
+    /// Wheel.
+    pub wheel: WheelGeometry,
+    /// Rail.
+    pub rail: RailGeometry,
+    /// Wheel material.
+    pub wheel_material: Material,
+    /// Rail material.
+    pub rail_material: Material,
+    /// Friction coefficient.
+    pub friction: f64,
+    /// Creep law.
+    pub creep_model: CreepModel,
+    /// Hunt–Crossley damping coefficient `d` in `f_n = K_h δ^{3/2}(1 + d δ̇)`, s/m.
+    pub damping: f64,
+    /// Search settings.
+    pub settings: ContactSettings,
+    previous: Vec<[f64; 4]>,
+    last_station: Option<f64>,
+}
+
+impl WheelRailContact {
+    /// New contact pair with steel on both sides, μ = 0.3, Shen–Hedrick–Elkins creep, no
+    /// damping and default settings.
+    pub fn new(wheel: WheelGeometry, rail: RailGeometry) -> Self {
+        Self {
+            wheel,
+            rail,
+            wheel_material: Material::steel(),
+            rail_material: Material::steel(),
+            friction: 0.3,
+            creep_model: CreepModel::ShenHedrickElkins,
+            damping: 0.0,
+            settings: ContactSettings::default(),
+            previous: Vec::new(),
+            last_station: None,
+        }
+    }
+
+    /// Forgets the warm-start state.
+    pub fn reset(&mut self) {
+        self.previous.clear();
+        self.last_station = None;
+    }
+
+    /// Previous solutions used for warm starts.
+    pub fn previous_solutions(&self) -> &[[f64; 4]] {
+        &self.previous
+    }
+
+    fn wheel_global(&self, pose: &WheelPose, u: f64, th: f64) -> [Vector3<f64>; 6] {
+        let w = self.wheel.surface(u, th);
+        let a = &pose.rotation;
+        [pose.position + a * w[0], a * w[1], a * w[2], a * w[3], a * w[4], a * w[5]]
+    }
+
+    /// Contact conditions `C(q)` of seed 000 §7.2 for `q = [s, v, u, θ]` (rail normal
+    /// oriented out of the rail).
+    pub fn constraint(&self, pose: &WheelPose, q: &[f64; 4]) -> Vector4<f64> {
+        let r = self.rail.surface(q[0], q[1]);
+        let w = self.wheel_global(pose, q[2], q[3]);
+        let d = w[0] - r[0];
+        let n = r[1].cross(&r[2]) * self.rail.side.sign();
+        Vector4::new(d.dot(&r[1]), d.dot(&r[2]), n.dot(&w[1]), n.dot(&w[2]))
+    }
+
+    /// Analytic Jacobian `∂C/∂q`.
+    pub fn constraint_jacobian(&self, pose: &WheelPose, q: &[f64; 4]) -> Matrix4<f64> {
+        let sg = self.rail.side.sign();
+        let [rr, rs, rv, rss, rsv, rvv] = self.rail.surface(q[0], q[1]);
+        let [rw, wu, wt, wuu, wut, wtt] = self.wheel_global(pose, q[2], q[3]);
+        let d = rw - rr;
+        let n = rs.cross(&rv) * sg;
+        let dn_ds = (rss.cross(&rv) + rs.cross(&rsv)) * sg;
+        let dn_dv = (rsv.cross(&rv) + rs.cross(&rvv)) * sg;
+        Matrix4::new(
+            -rs.dot(&rs) + d.dot(&rss),
+            -rv.dot(&rs) + d.dot(&rsv),
+            wu.dot(&rs),
+            wt.dot(&rs),
+            -rs.dot(&rv) + d.dot(&rsv),
+            -rv.dot(&rv) + d.dot(&rvv),
+            wu.dot(&rv),
+            wt.dot(&rv),
+            dn_ds.dot(&wu),
+            dn_dv.dot(&wu),
+            n.dot(&wuu),
+            n.dot(&wut),
+            dn_ds.dot(&wt),
+            dn_dv.dot(&wt),
+            n.dot(&wut),
+            n.dot(&wtt),
+        )
+    }
+
+    /// Newton–Raphson from `q0`; returns the converged parameters.
+    pub fn newton(&self, pose: &WheelPose, q0: [f64; 4]) -> Result<[f64; 4], ContactError> {
+        let mut q = q0;
+        let mut res = f64::INFINITY;
+        for it in 0..self.settings.max_iterations {
+            let c = self.constraint(pose, &q);
+            res = c.norm();
+            if !res.is_finite() {
+                return Err(ContactError::NoConvergence { iterations: it, residual: res });
+            }
+            let j = self.constraint_jacobian(pose, &q);
+            let dq = j.lu().solve(&(-c)).ok_or(ContactError::SingularJacobian)?;
+            // Damp large steps (profiles are only locally well approximated).
+            let lim = [0.05, 4e-3, 4e-3, 0.05];
+            let mut scale = 1.0f64;
+            for k in 0..4 {
+                if dq[k].abs() > lim[k] {
+                    scale = scale.min(lim[k] / dq[k].abs());
+                }
+            }
+            if dq.amax() < self.settings.newton_tolerance {
+                for k in 0..4 {
+                    q[k] += dq[k];
+                }
+                return Ok(q);
+            }
+            // Backtracking on |C| (the Newton direction is a descent direction for |C|²);
+            // this breaks the 2-cycles seen on strongly curved profile regions.
+            let mut alpha = scale;
+            let mut accepted = false;
+            for _ in 0..12 {
+                let mut trial = q;
+                for k in 0..4 {
+                    trial[k] += alpha * dq[k];
+                }
+                if self.constraint(pose, &trial).norm() < res {
+                    q = trial;
+                    accepted = true;
+                    break;
+                }
+                alpha *= 0.5;
+            }
+            if !accepted {
+                for k in 0..4 {
+                    q[k] += alpha * dq[k];
+                }
+            }
+        }
+        Err(ContactError::NoConvergence { iterations: self.settings.max_iterations, residual: res })
+    }
+
+    /// Geometry (points, normal, penetration, curvatures) at parameters `q`.
+    pub fn geometry_at(&self, pose: &WheelPose, q: [f64; 4], method: ContactMethod) -> ContactGeometry {
+        let sg = self.rail.side.sign();
+        let [rr, rs, rv, rss, rsv, rvv] = self.rail.surface(q[0], q[1]);
+        let [rw, wu, wt, wuu, wut, wtt] = self.wheel_global(pose, q[2], q[3]);
+        let n = (rs.cross(&rv) * sg).normalize();
+        let pen = -(rw - rr).dot(&n);
+        // Rolling direction: wheel circumferential tangent projected on the tangent plane,
+        // oriented with the direction of travel (body +x when at rest or moving forward).
+        let mut e1 = wt - n * wt.dot(&n);
+        let travel = if pose.velocity.norm() > 1e-9 { pose.velocity } else { pose.rotation.column(0).into() };
+        if e1.dot(&travel) < 0.0 {
+            e1 = -e1;
+        }
+        let e1 = e1.normalize();
+        let e2 = n.cross(&e1);
+        // Convex curvature tensors in the (e1, e2) basis; rail outward normal = n,
+        // wheel outward normal = −n.
+        let kr = curvature_tensor(&rs, &rv, &rss, &rsv, &rvv, &n, &e1, &e2, -1.0);
+        let kw = curvature_tensor(&wu, &wt, &wuu, &wut, &wtt, &n, &e1, &e2, 1.0);
+        let k = kr + kw;
+        // Principal values; assign the one whose direction is closer to e1 to x.
+        let (k11, k12, k22) = (k[(0, 0)], k[(0, 1)], k[(1, 1)]);
+        let mean = 0.5 * (k11 + k22);
+        let rad = (0.25 * (k11 - k22).powi(2) + k12 * k12).sqrt();
+        let (kx, ky) = if k11 <= k22 { (mean - rad, mean + rad) } else { (mean + rad, mean - rad) };
+        ContactGeometry {
+            params: q,
+            point_rail: rr,
+            point_wheel: rw,
+            normal: n,
+            e1,
+            e2,
+            penetration: pen,
+            curvature_x: 0.5 * kx,
+            curvature_y: 0.5 * ky,
+            method,
+        }
+    }
+
+    /// Vertical gap of the scan at lateral wheel coordinate `u`, with the station frame;
+    /// returns `(gap, [s, v, u, θ])`, `gap = +∞` when off the rail profile.
+    fn scan_gap(&self, pose: &WheelPose, s0: f64, fd: &RailFrameDerivs, u: f64) -> (f64, [f64; 4]) {
+        let sg = self.rail.side.sign();
+        let mt = fd.rot.transpose();
+        let w0 = self.wheel.surface(u, 0.0);
+        let centre = pose.position + pose.rotation * Vector3::new(0.0, w0[0].y, 0.0);
+        let a = mt * pose.rotation.column(0);
+        let b = mt * pose.rotation.column(2);
+        let cl = mt * (centre - fd.origin);
+        let th = (-a.z).atan2(b.z);
+        let rho = self.wheel.nominal_radius - self.wheel.profile.z(u);
+        let p = cl + (a * th.sin() - b * th.cos()) * rho;
+        let v = sg * p.y;
+        let (lo, hi) = self.rail.profile.y_range();
+        if v < lo || v > hi {
+            return (f64::INFINITY, [s0, v, u, th]);
+        }
+        (p.z - self.rail.profile.z(v), [s0 + p.x, v, u, th])
+    }
+
+    /// Seeds `(gap, q, u_lo, u_hi)` at the local minima of the scan gap.
+    fn scan(&self, pose: &WheelPose, s0: f64) -> Vec<(f64, [f64; 4], f64, f64)> {
+        let (lo, hi) = self.wheel.profile.y_range();
+        let n = self.settings.scan_points.max(8);
+        let us: Vec<f64> = (0..n).map(|i| lo + (hi - lo) * i as f64 / (n - 1) as f64).collect();
+        let fd = self.rail.frame_derivs(s0);
+        let vals: Vec<(f64, [f64; 4])> = us.iter().map(|&u| self.scan_gap(pose, s0, &fd, u)).collect();
+        let mut seeds = Vec::new();
+        for i in 1..n - 1 {
+            let g = vals[i].0;
+            if g.is_finite() && g <= vals[i - 1].0 && g < vals[i + 1].0 && g < self.settings.scan_gap_limit {
+                seeds.push((g, vals[i].1, us[i - 1], us[i + 1]));
+            }
+        }
+        seeds
+    }
+
+    /// Golden-section refinement of the scan gap on `[a, b]` (fallback).
+    fn refine_scan(&self, pose: &WheelPose, s0: f64, mut a: f64, mut b: f64) -> [f64; 4] {
+        let gr = 0.5 * (5f64.sqrt() - 1.0);
+        let frame = self.rail.frame_derivs(s0);
+        let f = |u: f64| self.scan_gap(pose, s0, &frame, u).0;
+        let mut c = b - gr * (b - a);
+        let mut d = a + gr * (b - a);
+        let (mut fc, mut fd) = (f(c), f(d));
+        for _ in 0..60 {
+            if fc < fd {
+                b = d;
+                d = c;
+                fd = fc;
+                c = b - gr * (b - a);
+                fc = f(c);
+            } else {
+                a = c;
+                c = d;
+                fc = fd;
+                d = a + gr * (b - a);
+                fd = f(d);
+            }
+        }
+        self.scan_gap(pose, s0, &frame, 0.5 * (a + b)).1
+    }
+
+    fn in_domain(&self, q: &[f64; 4]) -> bool {
+        let (rl, rh) = self.rail.profile.y_range();
+        let (wl, wh) = self.wheel.profile.y_range();
+        q.iter().all(|x| x.is_finite()) && q[1] >= rl && q[1] <= rh && q[2] >= wl && q[2] <= wh && q[3].abs() < 0.5
+    }
+
+    /// Finds all potential contact points (local minima of the gap with a vertical gap
+    /// below [`ContactSettings::scan_gap_limit`]), including separated ones (negative
+    /// penetration). Updates the warm-start state.
+    pub fn find_geometry(&mut self, pose: &WheelPose) -> Result<Vec<ContactGeometry>, ContactError> {
+        if !(pose.position.iter().all(|x| x.is_finite()) && pose.rotation.iter().all(|x| x.is_finite())) {
+            return Err(ContactError::InvalidInput("non-finite wheel pose".into()));
+        }
+        let s0 = self.rail.station(&pose.position, self.last_station)?;
+        self.last_station = Some(s0);
+        let mut out: Vec<ContactGeometry> = Vec::new();
+        // Warm start only.
+        if !self.settings.always_scan && !self.previous.is_empty() {
+            let mut ok = true;
+            for q0 in self.previous.clone() {
+                match self.newton(pose, q0) {
+                    Ok(q) if self.in_domain(&q) => out.push(self.geometry_at(pose, q, ContactMethod::Newton)),
+                    _ => {
+                        ok = false;
+                        break;
+                    }
+                }
+            }
+            if ok {
+                let out = self.dedup(out);
+                self.previous = out.iter().map(|g| g.params).collect();
+                return Ok(out);
+            }
+            out.clear();
+        }
+        for (_, seed, ulo, uhi) in self.scan(pose, s0) {
+            // Prefer a previous solution close to this seed as the starting guess.
+            let start = self.previous.iter().find(|p| (p[2] - seed[2]).abs() < 2e-3).copied().unwrap_or(seed);
+            let solved =
+                self.newton(pose, start).ok().filter(|q| self.in_domain(q) && (q[2] - seed[2]).abs() < 5e-3).or_else(
+                    || {
+                        if start != seed {
+                            self.newton(pose, seed).ok().filter(|q| self.in_domain(q) && (q[2] - seed[2]).abs() < 5e-3)
+                        } else {
+                            None
+                        }
+                    },
+                );
+            let newton_geo = solved
+                .map(|q| self.geometry_at(pose, q, ContactMethod::Newton))
+                .filter(|g| g.curvature_x > 0.0 && g.curvature_y > 0.0);
+            let g = match newton_geo {
+                Some(g) => g,
+                None => {
+                    let q = self.refine_scan(pose, s0, ulo, uhi);
+                    self.geometry_at(pose, q, ContactMethod::ScanFallback)
+                }
+            };
+            out.push(g);
+        }
+        let out = self.dedup(out);
+        self.previous = out.iter().map(|g| g.params).collect();
+        Ok(out)
+    }
+
+    fn dedup(&self, mut v: Vec<ContactGeometry>) -> Vec<ContactGeometry> {
+        v.sort_by(|a, b| b.penetration.total_cmp(&a.penetration));
+        let mut out: Vec<ContactGeometry> = Vec::new();
+        for g in v {
+            let dup = out.iter().any(|o| {
+                (o.params[1] - g.params[1]).abs() < self.settings.merge_distance
+                    && (o.params[2] - g.params[2]).abs() < self.settings.merge_distance
+            });
+            if !dup {
+                out.push(g);
+            }
+        }
+        out.sort_by(|a, b| a.params[2].total_cmp(&b.params[2]));
+        out
+    }
+
+    /// Contact points in contact (`δ > 0`) with normal and creep forces.
+    pub fn evaluate(&mut self, pose: &WheelPose) -> Result<Vec<ContactPoint>, ContactError> {
+        let geoms = self.find_geometry(pose)?;
+        let e_star = combined_modulus(&self.wheel_material, &self.rail_material);
+        let g_mod = 2.0 / (1.0 / self.wheel_material.shear_modulus() + 1.0 / self.rail_material.shear_modulus());
+        let nu = 0.5 * (self.wheel_material.poisson + self.rail_material.poisson);
+        let mut out = Vec::new();
+        for g in geoms.into_iter().filter(|g| g.penetration > 0.0) {
+            let kmin = self.settings.min_relative_curvature;
+            let hertz = HertzConstants::new(g.curvature_x.max(kmin), g.curvature_y.max(kmin), e_star)?;
+            let p = 0.5 * (g.point_rail + g.point_wheel);
+            let r = p - pose.position;
+            let v = pose.velocity + pose.angular_velocity.cross(&r);
+            let pen_rate = -v.dot(&g.normal);
+            let fe = hertz.force(g.penetration);
+            let fn_ = (fe * (1.0 + self.damping * pen_rate)).max(0.0);
+            let speed = pose.velocity.norm().max(self.settings.min_speed);
+            let creepages = Creepages {
+                longitudinal: v.dot(&g.e1) / speed,
+                lateral: v.dot(&g.e2) / speed,
+                spin: pose.angular_velocity.dot(&g.normal) / speed,
+            };
+            let (a, b) = hertz.semi_axes(fn_);
+            let creep = creep_forces(self.creep_model, &creepages, a, b, fn_, self.friction, g_mod, nu);
+            out.push(ContactPoint {
+                geometry: g,
+                hertz,
+                semi_axes: (a, b),
+                penetration_rate: pen_rate,
+                normal_force: fn_,
+                creepages,
+                creep,
+            });
+        }
+        Ok(out)
+    }
+}
+
+/// Convex curvature tensor of a surface in the basis `(e1, e2)` of the common tangent
+/// plane. `sign = −1` when `n` is the outward normal of the surface, `+1` when `−n` is.
+#[allow(clippy::too_many_arguments)]
+fn curvature_tensor(
+    r1: &Vector3<f64>,
+    r2: &Vector3<f64>,
+    r11: &Vector3<f64>,
+    r12: &Vector3<f64>,
+    r22: &Vector3<f64>,
+    n: &Vector3<f64>,
+    e1: &Vector3<f64>,
+    e2: &Vector3<f64>,
+    sign: f64,
+) -> nalgebra::Matrix2<f64> {
+    // Coordinates (α, β) of e in the parameter basis: least squares with the metric.
+    let gm = nalgebra::Matrix2::new(r1.dot(r1), r1.dot(r2), r1.dot(r2), r2.dot(r2));
+    let inv = gm.try_inverse().unwrap_or_else(nalgebra::Matrix2::zeros);
+    let coords = |e: &Vector3<f64>| inv * nalgebra::Vector2::new(r1.dot(e), r2.dot(e));
+    let (l, m, nn) = (r11.dot(n), r12.dot(n), r22.dot(n));
+    let ii = |x: nalgebra::Vector2<f64>, y: nalgebra::Vector2<f64>| {
+        sign * (x[0] * y[0] * l + (x[0] * y[1] + x[1] * y[0]) * m + x[1] * y[1] * nn)
+    };
+    let (c1, c2) = (coords(e1), coords(e2));
+    let k12 = ii(c1, c2);
+    nalgebra::Matrix2::new(ii(c1, c1), k12, k12, ii(c2, c2))
+}
