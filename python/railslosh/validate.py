@@ -39,6 +39,12 @@ _DESCRIPTIONS = {
     "all five constitutive models",
     "rigid-motion-invariance": "rigid motion gives zero viscous and penalty forces; rotating a deformed state "
     "rotates its forces (objectivity)",
+    "hydrostatic-cylinder": "half-full tank car at rest settles: vertical load = m g, no horizontal load or moment, "
+    "volume conserved, centroid height",
+    "slosh-rect-tank": "seed 003 rectangular tank (0.416 x 0.324 m, 0.132 m water), 0.3 g lateral pulse: "
+    "first-mode frequency vs analytic 1.436 Hz",
+    "tank-frame-equivalence": "same manoeuvre as tank-frame pseudo-forces and as prescribed inertial motion: "
+    "same loads within 1 %",
 }
 
 CASES: dict[str, Case] = {

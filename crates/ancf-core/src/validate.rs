@@ -32,11 +32,13 @@ pub struct Record {
 }
 
 impl Record {
-    fn abs(case: &str, quantity: impl Into<String>, measured: f64, reference: f64, tolerance: f64) -> Self {
+    /// Check |measured − reference| ≤ tolerance.
+    pub fn abs(case: &str, quantity: impl Into<String>, measured: f64, reference: f64, tolerance: f64) -> Self {
         let passed = (measured - reference).abs() <= tolerance && measured.is_finite();
         Self { case: case.into(), quantity: quantity.into(), measured, reference, tolerance, passed }
     }
-    fn at_most(case: &str, quantity: impl Into<String>, measured: f64, limit: f64) -> Self {
+    /// Check |measured| ≤ limit.
+    pub fn at_most(case: &str, quantity: impl Into<String>, measured: f64, limit: f64) -> Self {
         Self {
             case: case.into(),
             quantity: quantity.into(),

@@ -388,14 +388,20 @@ impl PyFluidBody {
 /// Names of the validation cases implemented in Rust.
 #[pyfunction]
 fn validation_cases() -> Vec<&'static str> {
-    ancf_core::validate::CASES.to_vec()
+    ancf_core::validate::CASES.iter().chain(rail_mbs::slosh::validate::CASES.iter()).copied().collect()
 }
 
 /// Run one validation case; returns a list of dict records.
 #[pyfunction]
 #[pyo3(signature = (name, quick=false))]
 fn run_validation<'py>(py: Python<'py>, name: String, quick: bool) -> PyResult<Vec<Bound<'py, PyDict>>> {
-    let recs = compute(py, move || ancf_core::validate::run_case(&name, quick))?;
+    let recs = compute(py, move || {
+        if rail_mbs::slosh::validate::CASES.contains(&name.as_str()) {
+            rail_mbs::slosh::validate::run_case(&name, quick)
+        } else {
+            ancf_core::validate::run_case(&name, quick)
+        }
+    })?;
     recs.into_iter()
         .map(|r| {
             let d = PyDict::new(py);

@@ -547,7 +547,11 @@ impl<S: MechanicalSystem> Hht<S> {
     /// after the first iteration.
     fn eval_residual_terms(&mut self, t1: f64) -> Result<Option<IntegratorError>, IntegratorError> {
         self.force.fill(0.0);
-        self.system.forces(t1, &self.q_it, &self.v_it, &mut self.force).map_err(sys_err(t1))?;
+        // A model error at a trial iterate (e.g. an element inverted by too large a step)
+        // is recoverable: the step is retried (smaller, in adaptive mode).
+        if let Err(e) = self.system.forces(t1, &self.q_it, &self.v_it, &mut self.force) {
+            return Ok(Some(sys_err(t1)(e)));
+        }
         if let Err(e) = check_finite(&self.force, t1, Quantity::Forces) {
             return Ok(Some(e));
         }
@@ -580,9 +584,9 @@ impl<S: MechanicalSystem> Hht<S> {
         self.factor_h = None;
         self.dq_vals.fill(0.0);
         self.dv_vals.fill(0.0);
-        self.system
-            .force_jacobians(t1, &self.q_it, &self.v_it, &mut self.dq_vals, &mut self.dv_vals)
-            .map_err(sys_err(t1))?;
+        if let Err(e) = self.system.force_jacobians(t1, &self.q_it, &self.v_it, &mut self.dq_vals, &mut self.dv_vals) {
+            return Ok(Some(sys_err(t1)(e)));
+        }
         if let Err(e) = check_finite(&self.dq_vals, t1, Quantity::ForceJacobianQ) {
             return Ok(Some(e));
         }
@@ -659,7 +663,7 @@ impl<S: MechanicalSystem> Hht<S> {
             let tic = Instant::now();
             self.newmark_update(h);
             if let Some(err) = self.eval_residual_terms(t1)? {
-                if k == 0 {
+                if k == 0 && !matches!(err, IntegratorError::System { .. }) {
                     return Err(err);
                 }
                 self.stats.time_assembly += tic.elapsed();
@@ -691,7 +695,7 @@ impl<S: MechanicalSystem> Hht<S> {
             let refresh = refresh_next || mode == RefreshMode::EveryIteration || !self.jac_valid;
             if refresh {
                 if let Some(err) = self.eval_jacobians(t1)? {
-                    if k == 0 {
+                    if k == 0 && !matches!(err, IntegratorError::System { .. }) {
                         return Err(err);
                     }
                     self.stats.time_assembly += tic.elapsed();

@@ -6,6 +6,7 @@
 
 pub mod motion;
 pub mod system;
+pub mod validate;
 
 pub use motion::{PiecewiseAcceleration, PrescribedMotion, TankState};
 pub use system::{SloshFrame, SloshSystem};
