@@ -23,6 +23,9 @@ def test_validate_lists_its_cases():
         "hydrostatic-cylinder",
         "slosh-rect-tank",
         "tank-frame-equivalence",
+        "slosh-cylinder-half",
+        "slosh-viscous-decay",
+        "bulkhead-longitudinal",
     ):
         assert case in out.stdout
 

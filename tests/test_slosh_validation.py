@@ -9,9 +9,19 @@ import pytest
 from railslosh import validate
 
 
-@pytest.mark.parametrize("case", ["hydrostatic-cylinder", "slosh-rect-tank", "tank-frame-equivalence"])
+@pytest.mark.parametrize(
+    "case",
+    [
+        "hydrostatic-cylinder",
+        "slosh-rect-tank",
+        "slosh-cylinder-half",
+        "slosh-viscous-decay",
+        "tank-frame-equivalence",
+        "bulkhead-longitudinal",
+    ],
+)
 def test_quick_slosh_case_passes(case):
     records = validate.run([case], quick=True)
-    assert len(records) >= 2
+    assert len(records) >= 1
     failed = [r for r in records if not r["passed"]]
     assert not failed, failed

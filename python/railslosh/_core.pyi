@@ -124,5 +124,21 @@ def elliptic_cylinder(
     n_height: int,
 ) -> FluidMesh: ...
 def validation_cases() -> list[str]: ...
+def run_slosh(
+    mesh: FluidMesh,
+    fluid: Fluid,
+    tank_shape: str,
+    tank_dims: list[float],
+    bulkheads: list[tuple[float, float]],
+    acceleration: list[list[tuple[float, float]]],
+    rotation_axis: tuple[float, float, float] | None,
+    angular_acceleration: list[tuple[float, float]],
+    t_end: float,
+    h: float,
+    frame: str = "inertial",
+    gravity: list[float] = ...,
+    viscous_points: int = 3,
+    penalty_points: int = 3,
+) -> dict[str, Any]: ...
 def run_validation(name: str, quick: bool = False) -> list[dict[str, Any]]: ...
 def _panic_for_test() -> None: ...

@@ -43,6 +43,12 @@ _DESCRIPTIONS = {
     "volume conserved, centroid height",
     "slosh-rect-tank": "seed 003 rectangular tank (0.416 x 0.324 m, 0.132 m water), 0.3 g lateral pulse: "
     "first-mode frequency vs analytic 1.436 Hz",
+    "slosh-cylinder-half": "half-full horizontal cylinder: transverse mode lambda vs 1.3557 (full form), "
+    "longitudinal mode vs the rectangular-tank formula",
+    "slosh-viscous-decay": "free sloshing decays faster from water through the crude oils of seed 000 Table 2; "
+    "heavy crude settles within one period",
+    "bulkhead-longitudinal": "three-compartment tank car has a lower peak longitudinal load than the open tank "
+    "under the same braking pulse",
     "tank-frame-equivalence": "same manoeuvre as tank-frame pseudo-forces and as prescribed inertial motion: "
     "same loads within 1 %",
 }

@@ -455,3 +455,99 @@ pub fn elliptic_cylinder(spec: &EllipticCylinderSpec) -> Result<FluidMesh> {
         format!("elliptic cylinder a={a:.5} b={b:.5} L={l} fill={}", spec.fill),
     ))
 }
+
+/// Concatenate meshes into one (disconnected blocks, e.g. tank compartments).
+pub fn merge(blocks: Vec<FluidMesh>, kind: String) -> FluidMesh {
+    let mut out = FluidMesh {
+        nodes: Vec::new(),
+        elements: Vec::new(),
+        lengths: Vec::new(),
+        counts: [0, 0, 0],
+        boundary: Vec::new(),
+        exact_volume: 0.0,
+        free_surface_z: blocks.first().map_or(0.0, |b| b.free_surface_z),
+        kind,
+    };
+    for b in blocks {
+        let (n0, e0) = (out.nodes.len(), out.elements.len());
+        out.nodes.extend(b.nodes);
+        out.elements.extend(b.elements.iter().map(|e| e.map(|n| n + n0)));
+        out.lengths.extend(b.lengths);
+        out.boundary.extend(b.boundary.iter().map(|f| BoundaryFace { element: f.element + e0, ..*f }));
+        out.counts[0] += b.counts[0];
+        out.counts[1] = out.counts[1].max(b.counts[1]);
+        out.counts[2] = out.counts[2].max(b.counts[2]);
+        out.exact_volume += b.exact_volume;
+    }
+    out
+}
+
+/// The liquid of a tank car divided into compartments by bulkheads (planes across the
+/// tank at `bulkheads[i].0` with thickness `bulkheads[i].1`, tank frame). All compartments
+/// have the same free-surface height, set by `spec.fill` as a fraction of the tank volume
+/// (ignoring the bulkheads); `spec.n_length` elements are shared among the compartments in
+/// proportion to their length (at least one each).
+pub fn cylinder_tank_compartments(spec: &CylinderTankSpec, bulkheads: &[(f64, f64)]) -> Result<FluidMesh> {
+    spec.validate()?;
+    let (l, r, d) = (spec.length, spec.radius, spec.head_depth);
+    let ltot = l + 2.0 * d;
+    let mut cuts = vec![];
+    for (i, &(x, t)) in bulkheads.iter().enumerate() {
+        check_positive(&format!("bulkheads[{i}].thickness"), t)?;
+        if !(x - t / 2.0 > -l / 2.0 && x + t / 2.0 < l / 2.0) {
+            return Err(invalid(
+                &format!("bulkheads[{i}].x"),
+                x,
+                &format!("within the shell, in ({}, {})", -l / 2.0, l / 2.0),
+            ));
+        }
+        if let Some(&(xp, tp)) = cuts.last() {
+            let (xp, tp): (f64, f64) = (xp, tp);
+            if x - t / 2.0 <= xp + tp / 2.0 {
+                return Err(invalid(&format!("bulkheads[{i}].x"), x, "increasing and not overlapping"));
+            }
+        }
+        cuts.push((x, t));
+    }
+    let h = spec.liquid_depth();
+    let zs = h - r;
+    let width = 2.0 * r;
+    // compartment ends: None = head surface
+    let mut ends: Vec<(Option<f64>, Option<f64>)> = Vec::new();
+    let mut lo = None;
+    for &(x, t) in &cuts {
+        ends.push((lo, Some(x - t / 2.0)));
+        lo = Some(x + t / 2.0);
+    }
+    ends.push((lo, None));
+    let nominal = |e: Option<f64>, sign: f64| e.unwrap_or(sign * ltot / 2.0);
+    let lens: Vec<f64> = ends.iter().map(|(a, b)| nominal(*b, 1.0) - nominal(*a, -1.0)).collect();
+    let total: f64 = lens.iter().sum();
+    let mut blocks = Vec::new();
+    for ((a, b), len) in ends.iter().zip(&lens) {
+        let n = ((spec.n_length as f64 * len / total).round() as usize).max(1);
+        let (a, b) = (*a, *b);
+        let u = graded_nodes(n, *len, 1.0);
+        let v = graded_nodes(spec.n_width, width, 1.0);
+        let w = graded_nodes(spec.n_height, h, 1.0);
+        let len = *len;
+        let section = segment_map(r, r, zs);
+        let map = move |p: [f64; 3]| {
+            let (y, z) = section(p[1] / width, p[2] / h);
+            let rho2 = ((y * y + z * z) / (r * r)).min(1.0);
+            let xh = 0.5 * l + d * (1.0 - rho2).sqrt();
+            let x0 = a.unwrap_or(-xh);
+            let x1 = b.unwrap_or(xh);
+            [x0 + (p[0] / len) * (x1 - x0), y, z]
+        };
+        // exact volume of the compartment below the free surface
+        let seg = circle_segment_area(r, h);
+        let heads = |e: Option<f64>| {
+            if e.is_none() { 0.5 * (d / r) * std::f64::consts::PI * h * h * (3.0 * r - h) / 3.0 } else { 0.0 }
+        };
+        let shell = b.unwrap_or(l / 2.0) - a.unwrap_or(-l / 2.0);
+        let exact = shell * seg + heads(a) + heads(b);
+        blocks.push(structured(&u, &v, &w, map, true, exact, zs, String::new()));
+    }
+    Ok(merge(blocks, format!("cylinder tank L={l} R={r} head={d} fill={} with {} bulkheads", spec.fill, cuts.len())))
+}

@@ -384,3 +384,35 @@ fn kinetic_energy_and_centre_of_mass_of_rigid_translation() {
     let fz: f64 = fg.iter().skip(2).step_by(12).sum();
     assert!((fz + m * 9.81).abs() < 1e-10);
 }
+
+#[test]
+fn compartment_meshes_fill_each_compartment_and_leave_the_bulkheads_free() {
+    use ancf_core::mesh::cylinder_tank_compartments;
+    let spec = CylinderTankSpec {
+        length: 12.0,
+        radius: 1.5,
+        head_depth: 0.5,
+        fill: 0.5,
+        n_length: 9,
+        n_width: 4,
+        n_height: 2,
+        grading: 1.0,
+    };
+    let bulk = [(-2.0, 0.02), (2.0, 0.02)];
+    let mesh = cylinder_tank_compartments(&spec, &bulk).unwrap();
+    assert_eq!(mesh.n_elements(), 9 * 8);
+    for n in &mesh.nodes {
+        for (x, t) in bulk {
+            assert!((n[0] - x).abs() >= t / 2.0 - 1e-12, "node inside bulkhead: {}", n[0]);
+        }
+    }
+    let body = FluidBody::new(mesh, newtonian(0.01, 0.0), QuadratureOptions::default()).unwrap();
+    let err = body.reference_volume() / body.mesh.exact_volume - 1.0;
+    assert!(err.abs() < 0.01, "{err}");
+    // the bulkhead slabs take their volume out of the open-tank volume
+    let open = cylinder_tank(&spec).unwrap();
+    let slab = 2.0 * 0.02 * std::f64::consts::PI * 1.5f64.powi(2) / 2.0;
+    assert!((open.exact_volume - body.mesh.exact_volume - slab).abs() < 1e-9);
+    assert!(cylinder_tank_compartments(&spec, &[(2.0, 0.02), (-2.0, 0.02)]).is_err());
+    assert!(cylinder_tank_compartments(&spec, &[(6.5, 0.02)]).is_err());
+}

@@ -385,6 +385,122 @@ impl PyFluidBody {
     }
 }
 
+/// Run fluid sloshing in a rigid tank with prescribed motion (see `railslosh.slosh.run`).
+///
+/// Returns a dict of numpy arrays (`t`, `force_tank`, `moment_tank`, `force_global`,
+/// `moment_global`, `com_tank`, `volume`, `kinetic_energy`, `potential_energy`,
+/// `newton_iterations`, `max_penetration`) plus `error` (None, or the message of the failure
+/// that stopped the run; the arrays then hold everything computed before it) and `stats`.
+#[pyfunction]
+#[pyo3(signature = (mesh, fluid, tank_shape, tank_dims, bulkheads, acceleration, rotation_axis, angular_acceleration,
+                    t_end, h, frame="inertial", gravity=[0.0, 0.0, -9.81], viscous_points=3, penalty_points=3))]
+#[allow(clippy::too_many_arguments)]
+fn run_slosh<'py>(
+    py: Python<'py>,
+    mesh: &PyFluidMesh,
+    fluid: &PyFluid,
+    tank_shape: &str,
+    tank_dims: Vec<f64>,
+    bulkheads: Vec<(f64, f64)>,
+    acceleration: [Vec<(f64, f64)>; 3],
+    rotation_axis: Option<[f64; 3]>,
+    angular_acceleration: Vec<(f64, f64)>,
+    t_end: f64,
+    h: f64,
+    frame: &str,
+    gravity: [f64; 3],
+    viscous_points: usize,
+    penalty_points: usize,
+) -> PyResult<Bound<'py, PyDict>> {
+    use ancf_core::contact::{WallContact, WallContactLaw};
+    use ancf_core::tank::{Bulkhead, TankGeometry, TankShape};
+    use rail_mbs::slosh::{PiecewiseAcceleration, PrescribedMotion, SloshFrame, SloshRun, SloshSystem};
+    let bad =
+        |f: &str, v: String, a: &str| PyValueError::new_err(format!("invalid parameter `{f}` = {v}: allowed {a}"));
+    let shape = match (tank_shape, tank_dims.as_slice()) {
+        ("cylinder", &[length, radius, head_depth]) => TankShape::Cylinder { length, radius, head_depth },
+        ("elliptic", &[length, semi_axis_y, semi_axis_z]) => {
+            TankShape::EllipticCylinder { length, semi_axis_y, semi_axis_z }
+        }
+        ("box", &[x0, y0, z0, x1, y1, z1]) => TankShape::Box { min: [x0, y0, z0], max: [x1, y1, z1] },
+        _ => {
+            return Err(bad(
+                "tank",
+                format!("{tank_shape} {tank_dims:?}"),
+                "cylinder [length, radius, head_depth], elliptic [length, semi_axis_y, semi_axis_z] or box [min xyz, max xyz]",
+            ));
+        }
+    };
+    let frame = match frame {
+        "inertial" => SloshFrame::Inertial,
+        "tank" => SloshFrame::Tank,
+        other => return Err(bad("frame", format!("{other:?}"), "\"inertial\" or \"tank\"")),
+    };
+    if !(t_end.is_finite() && t_end > 0.0) {
+        return Err(bad("t_end", t_end.to_string(), "a finite number > 0"));
+    }
+    if !(h.is_finite() && h > 0.0 && h <= t_end) {
+        return Err(bad("h", h.to_string(), "a finite number in (0, t_end]"));
+    }
+    let (m, f) = (mesh.inner.clone(), fluid.inner);
+    let result = compute(py, move || {
+        let q = QuadratureOptions { viscous: viscous_points, penalty: penalty_points, mass: 4 };
+        let body = FluidBody::new(m, f, q)?;
+        let bh = bulkheads.iter().map(|&(x, thickness)| Bulkhead { x, thickness }).collect();
+        let geo = TankGeometry::new(shape, bh)?;
+        let depth =
+            (body.mesh.free_surface_z - body.mesh.nodes.iter().map(|n| n[2]).fold(f64::INFINITY, f64::min)).max(1e-3);
+        let g = (gravity[0].powi(2) + gravity[1].powi(2) + gravity[2].powi(2)).sqrt().max(1e-3);
+        let contact = WallContact::new(&body, geo, WallContactLaw::default_for(f.density, g, depth))?;
+        let mut motion = PrescribedMotion::at_rest([0.0; 3]);
+        let names = ["acceleration.x", "acceleration.y", "acceleration.z"];
+        for d in 0..3 {
+            if !acceleration[d].is_empty() {
+                motion.translation[d] = PiecewiseAcceleration::new(names[d], &acceleration[d])?;
+            }
+        }
+        if let Some(axis) = rotation_axis {
+            motion.rotation = Some((axis, PiecewiseAcceleration::new("angular_acceleration", &angular_acceleration)?));
+        }
+        let sys = SloshSystem::new(body, contact, motion, gravity, frame)?;
+        let mut run = SloshRun::new(sys, 0.0, rail_mbs::slosh::validate::slosh_params())
+            .map_err(|e| AncfError::NonFinite { what: e.to_string(), element: 0 })?;
+        let err = run.run_to(t_end, h).err().map(|e| e.error.to_string());
+        let s = *run.stats();
+        Ok((run.record, err, s))
+    })?;
+    let (rec, err, stats) = result;
+    let d = PyDict::new(py);
+    let v3 = |x: &Vec<[f64; 3]>| -> PyResult<Bound<'py, PyAny>> {
+        let n = x.len();
+        Ok(PyArray1::from_vec(py, x.iter().flatten().copied().collect()).reshape([n, 3])?.into_any())
+    };
+    d.set_item("t", PyArray1::from_vec(py, rec.t))?;
+    d.set_item("force_tank", v3(&rec.force_tank)?)?;
+    d.set_item("moment_tank", v3(&rec.moment_tank)?)?;
+    d.set_item("force_global", v3(&rec.force_global)?)?;
+    d.set_item("moment_global", v3(&rec.moment_global)?)?;
+    d.set_item("com_tank", v3(&rec.com_tank)?)?;
+    d.set_item("volume", PyArray1::from_vec(py, rec.volume))?;
+    d.set_item("kinetic_energy", PyArray1::from_vec(py, rec.kinetic_energy))?;
+    d.set_item("potential_energy", PyArray1::from_vec(py, rec.potential_energy))?;
+    d.set_item("newton_iterations", PyArray1::from_vec(py, rec.newton_iterations.iter().map(|&x| x as i64).collect()))?;
+    d.set_item("max_penetration", PyArray1::from_vec(py, rec.max_penetration))?;
+    d.set_item("error", err)?;
+    let st = PyDict::new(py);
+    st.set_item("steps", stats.steps)?;
+    st.set_item("rejected_steps", stats.rejected_steps)?;
+    st.set_item("newton_iterations", stats.newton_iterations)?;
+    st.set_item("factorizations", stats.factorizations)?;
+    st.set_item("jacobian_evaluations", stats.jacobian_evaluations)?;
+    st.set_item("time_assembly", stats.time_assembly.as_secs_f64())?;
+    st.set_item("time_factorization", stats.time_factorization.as_secs_f64())?;
+    st.set_item("time_solve", stats.time_solve.as_secs_f64())?;
+    st.set_item("time_total", stats.time_total.as_secs_f64())?;
+    d.set_item("stats", st)?;
+    Ok(d)
+}
+
 /// Names of the validation cases implemented in Rust.
 #[pyfunction]
 fn validation_cases() -> Vec<&'static str> {
@@ -433,6 +549,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(cylinder_tank, m)?)?;
     m.add_function(wrap_pyfunction!(elliptic_cylinder, m)?)?;
     m.add_function(wrap_pyfunction!(validation_cases, m)?)?;
+    m.add_function(wrap_pyfunction!(run_slosh, m)?)?;
     m.add_function(wrap_pyfunction!(run_validation, m)?)?;
     m.add_function(wrap_pyfunction!(_panic_for_test, m)?)?;
     Ok(())

@@ -171,7 +171,7 @@ pub enum IntegratorError {
         rate: f64,
     },
     /// Adaptive stepping needed a step below `h_min`.
-    #[error("step size {h} s below h_min = {h_min} s at t = {t} s")]
+    #[error("step size {h} s below h_min = {h_min} s at t = {t} s; last failure: {cause}")]
     StepTooSmall {
         /// Time at which the step failed, s.
         t: f64,
@@ -179,6 +179,8 @@ pub enum IntegratorError {
         h: f64,
         /// Configured minimum step size, s.
         h_min: f64,
+        /// Why the last attempt failed (e.g. Newton divergence, an inverted element).
+        cause: String,
     },
     /// The sparse linear solver failed for a reason other than singularity
     /// (out of memory, index overflow).

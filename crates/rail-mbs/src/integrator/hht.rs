@@ -509,7 +509,12 @@ impl<S: MechanicalSystem> Hht<S> {
                     };
                     let h_new = h * p.decrease;
                     if h_new < p.h_min {
-                        return Err(IntegratorError::StepTooSmall { t: self.t, h: h_new, h_min: p.h_min });
+                        return Err(IntegratorError::StepTooSmall {
+                            t: self.t,
+                            h: h_new,
+                            h_min: p.h_min,
+                            cause: give_up(h).to_string(),
+                        });
                     }
                     h = h_new;
                     self.h_current = h;
