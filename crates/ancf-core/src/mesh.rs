@@ -323,6 +323,21 @@ pub struct CylinderTankSpec {
 }
 
 impl CylinderTankSpec {
+    /// The half-full tank car of seed 000 §8.1 (12 m shell, radius 1.5 m; head depth 0.5 m,
+    /// our choice, see `python/railslosh/mesh.py`) with the given element counts.
+    pub fn tank_car(counts: [usize; 3]) -> Self {
+        Self {
+            length: 12.0,
+            radius: 1.5,
+            head_depth: 0.5,
+            fill: 0.5,
+            n_length: counts[0],
+            n_width: counts[1],
+            n_height: counts[2],
+            grading: 1.0,
+        }
+    }
+
     /// Validate every field; errors name the field and the allowed range.
     pub fn validate(&self) -> Result<()> {
         check_positive("length", self.length)?;

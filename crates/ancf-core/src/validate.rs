@@ -154,16 +154,7 @@ fn element_mass() -> Result<Vec<Record>> {
         1e-12,
     ));
     for (n, tol) in [([8, 4, 2], 6e-3), ([16, 8, 4], 2.5e-3)] {
-        let spec = CylinderTankSpec {
-            length: 12.0,
-            radius: 1.5,
-            head_depth: 0.5,
-            fill: 0.5,
-            n_length: n[0],
-            n_width: n[1],
-            n_height: n[2],
-            grading: 1.0,
-        };
+        let spec = CylinderTankSpec::tank_car(n);
         let body = FluidBody::new(cylinder_tank(&spec)?, fluid, QuadratureOptions::default())?;
         out.push(Record::abs(
             c,

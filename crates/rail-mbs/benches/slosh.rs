@@ -27,16 +27,7 @@ fn main() {
     );
     let cases: &[([usize; 3], f64)] = if quick { &[([6, 4, 2], 1.0)] } else { &[([6, 4, 2], 2.0), ([25, 5, 4], 0.3)] };
     for &(n, t_end) in cases {
-        let spec = CylinderTankSpec {
-            length: 12.0,
-            radius: 1.5,
-            head_depth: 0.5,
-            fill: 0.5,
-            n_length: n[0],
-            n_width: n[1],
-            n_height: n[2],
-            grading: 1.0,
-        };
+        let spec = CylinderTankSpec::tank_car(n);
         let mesh = cylinder_tank(&spec).unwrap();
         let fluid = liquid(850.0, Rheology::Newtonian { viscosity: 0.005 }, 1.5, 1.5 / n[2] as f64).unwrap();
         let body = FluidBody::new(mesh, fluid, QuadratureOptions::default()).unwrap();

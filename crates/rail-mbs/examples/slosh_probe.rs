@@ -28,16 +28,7 @@ fn main() {
             0.066,
         )
     } else {
-        let spec = CylinderTankSpec {
-            length: 12.0,
-            radius: 1.5,
-            head_depth: 0.5,
-            fill: 0.5,
-            n_length: 6,
-            n_width: 4,
-            n_height: 2,
-            grading: 1.0,
-        };
+        let spec = CylinderTankSpec::tank_car([6, 4, 2]);
         (
             cylinder_tank(&spec).unwrap(),
             TankGeometry::new(TankShape::Cylinder { length: 12.0, radius: 1.5, head_depth: 0.5 }, vec![]).unwrap(),

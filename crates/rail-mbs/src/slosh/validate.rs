@@ -107,16 +107,7 @@ fn hydrostatic_cylinder(quick: bool) -> Result<Vec<Record>> {
     let c = "hydrostatic-cylinder";
     let (r, l, hd) = (1.5, 12.0, 0.5);
     let (n, t_end) = if quick { ([4, 2, 2], 1.5) } else { ([6, 4, 2], 3.0) };
-    let spec = CylinderTankSpec {
-        length: l,
-        radius: r,
-        head_depth: hd,
-        fill: 0.5,
-        n_length: n[0],
-        n_width: n[1],
-        n_height: n[2],
-        grading: 1.0,
-    };
+    let spec = CylinderTankSpec::tank_car(n);
     let mesh = cylinder_tank(&spec)?;
     let fluid = liquid(850.0, Rheology::Newtonian { viscosity: 0.005 }, r, r / n[2] as f64)?;
     let geo = TankGeometry::new(TankShape::Cylinder { length: l, radius: r, head_depth: hd }, vec![])?;
@@ -457,16 +448,7 @@ fn bulkhead_longitudinal(quick: bool) -> Result<Vec<Record>> {
     let c = "bulkhead-longitudinal";
     let (r, l, hd) = (1.5, 12.0, 0.5);
     let (n, t_end) = if quick { ([6, 2, 2], 5.0) } else { ([9, 4, 2], 8.0) };
-    let spec = CylinderTankSpec {
-        length: l,
-        radius: r,
-        head_depth: hd,
-        fill: 0.5,
-        n_length: n[0],
-        n_width: n[1],
-        n_height: n[2],
-        grading: 1.0,
-    };
+    let spec = CylinderTankSpec::tank_car(n);
     let cuts = [(-2.0, 0.02), (2.0, 0.02)];
     // braking pulse: -0.1 g (about the mean of 40 -> 5 km/h in 10 s) after 0.5 s at rest
     let mut motion = PrescribedMotion::at_rest([0.0; 3]);
