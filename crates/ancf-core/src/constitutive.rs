@@ -58,7 +58,7 @@
 
 use nalgebra::Matrix3;
 
-use crate::error::{Result, check_non_negative, check_positive, check_range, invalid};
+use crate::error::{Result, check_non_negative, check_positive, check_range};
 
 /// 3×3 matrix type used at material points.
 pub type M3 = Matrix3<f64>;
@@ -373,15 +373,4 @@ pub fn smoothstep(t: f64) -> (f64, f64) {
     } else {
         (t * t * (3.0 - 2.0 * t), 6.0 * t * (1.0 - t))
     }
-}
-
-/// Validate that a fluid definition makes sense for an Oldroyd default modulus etc.
-/// (kept separate so that callers building fluids from files get one error path).
-pub fn require_valid(fluid: &Fluid) -> Result<()> {
-    fluid.validate().map_err(|e| match e {
-        crate::error::AncfError::InvalidParameter { field, value, allowed } => {
-            invalid(&format!("fluid.{field}"), value, &allowed)
-        }
-        other => other,
-    })
 }

@@ -15,7 +15,6 @@
 use std::collections::HashMap;
 
 use ancf_core::FluidBody;
-use ancf_core::constitutive::M3;
 use ancf_core::contact::{ContactLoad, PointJacobian, TankKinematics, WallContact};
 use ancf_core::error::AncfError;
 use ancf_core::shape::N_SHAPE;
@@ -284,9 +283,4 @@ impl MechanicalSystem for SloshSystem {
         self.point_jac = pj;
         Ok(())
     }
-}
-
-/// 3×3 identity (re-exported for callers building rotations).
-pub fn identity() -> M3 {
-    M3::identity()
 }

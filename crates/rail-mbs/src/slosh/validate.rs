@@ -187,28 +187,6 @@ pub fn dominant_frequency(t: &[f64], x: &[f64], t0: f64, f_lo: f64, f_hi: f64) -
     grid[ib] + off * (f_hi - f_lo) / m as f64
 }
 
-/// Average period of the zero crossings of `x − mean` for t ≥ t0.
-pub fn zero_crossing_frequency(t: &[f64], x: &[f64], t0: f64) -> f64 {
-    let idx: Vec<usize> = (0..t.len()).filter(|&i| t[i] >= t0).collect();
-    if idx.len() < 3 {
-        return f64::NAN;
-    }
-    let mean = idx.iter().map(|&i| x[i]).sum::<f64>() / idx.len() as f64;
-    let mut crossings = Vec::new();
-    for w in idx.windows(2) {
-        let (a, b) = (x[w[0]] - mean, x[w[1]] - mean);
-        if a == 0.0 || a.signum() != b.signum() {
-            let s = a / (a - b);
-            crossings.push(t[w[0]] + s * (t[w[1]] - t[w[0]]));
-        }
-    }
-    if crossings.len() < 3 {
-        return f64::NAN;
-    }
-    let span = crossings[crossings.len() - 1] - crossings[0];
-    (crossings.len() - 1) as f64 / (2.0 * span)
-}
-
 /// Analytic first sloshing frequency of a rectangular tank of length `l` along the motion,
 /// depth `h`: f = √(g k tanh(k h)) / 2π, k = π / l (seed 003 appendix C §4.1).
 pub fn rect_tank_frequency(l: f64, h: f64) -> f64 {
