@@ -67,7 +67,8 @@ def test_unknown_case_is_a_usage_error():
 
 @pytest.mark.parametrize("oil", ["light", "heavy"])
 def test_demo_runs_and_reports(oil):
-    out = run_cli("demo", "--oil", oil)
+    out = run_cli("demo", "--oil", oil, "--t-end", "1.0")
     assert out.returncode == 0, out.stderr
     assert "1260 coordinates" in out.stdout
+    assert "peak longitudinal load" in out.stdout
     assert "0 failed" in out.stdout
