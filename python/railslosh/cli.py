@@ -128,6 +128,12 @@ def main(argv: list[str] | None = None) -> int:
     except ValueError as exc:
         print(f"railslosh {args.command}: {exc}", file=sys.stderr)
         return 2
+    except BrokenPipeError:
+        # output piped into e.g. `head`: stop quietly, like other command-line tools
+        import os
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
 
 
 if __name__ == "__main__":
