@@ -341,6 +341,8 @@ fn assemble_tangents(
     if np == 0 {
         return;
     }
+    // only the first 3·np columns are filled (a skipped penalty pass leaves the rest unused)
+    let bcat = bcat.as_ref().subcols(0, 3 * np);
     let mut bt = Mat::<f64>::zeros(2 * N_SHAPE, 3 * np);
     let mut out = Mat::<f64>::zeros(2 * N_SHAPE, N_SHAPE);
     for i in 0..3 {

@@ -416,3 +416,21 @@ fn compartment_meshes_fill_each_compartment_and_leave_the_bulkheads_free() {
     assert!(cylinder_tank_compartments(&spec, &[(2.0, 0.02), (-2.0, 0.02)]).is_err());
     assert!(cylinder_tank_compartments(&spec, &[(6.5, 0.02)]).is_err());
 }
+
+#[test]
+fn jacobians_without_penalty_terms_match_finite_differences() {
+    // bulk_penalty = bulk_damping = 0 skips the penalty pass: the Jacobian assembly must use
+    // only the viscous points (regression: a shape mismatch in the GEMM assembly)
+    let tables = ShapeTables::new(QuadratureOptions::default()).unwrap();
+    let l = [0.4, 0.3, 0.2];
+    let e0 = box_element([0.0; 3], l);
+    let el = ElementRef::new(0, &e0, l, &tables).unwrap();
+    let mut rng = Rng::new(8);
+    let e: Vec<f64> = flat(&e0).iter().map(|x| x + 0.02 * rng.uniform()).collect();
+    let v: Vec<f64> = e.iter().map(|_| 0.3 * rng.uniform()).collect();
+    for rheology in [Rheology::Newtonian { viscosity: 0.7 }, Rheology::Bingham { viscosity: 0.5, yield_stress: 2.0 }] {
+        let fluid = Fluid::new(1000.0, rheology, 0.0).unwrap();
+        let (ek, ec) = ancf_core::validate::jacobian_fd_error(&fluid, &el, &tables, &e, &v).unwrap();
+        assert!(ek < 1e-6 && ec < 1e-6, "{}: {ek:e} {ec:e}", rheology.name());
+    }
+}
