@@ -55,7 +55,7 @@ fn main() {
             .unwrap(),
     ];
     for fluid in fluids {
-        for (nv, np) in [(3, 1), (3, 2), (4, 2), (4, 3)] {
+        for (nv, np) in [(3, 1), (3, 2), (3, 3), (4, 2), (4, 3)] {
             let body =
                 FluidBody::new(mesh.clone(), fluid, QuadratureOptions { viscous: nv, penalty: np, mass: 4 }).unwrap();
             let mut rng = Rng::new(1);
