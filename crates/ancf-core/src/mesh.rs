@@ -376,24 +376,42 @@ impl CylinderTankSpec {
 /// front head, so the mesh fills exactly the tank interior below the free surface.
 pub fn cylinder_tank(spec: &CylinderTankSpec) -> Result<FluidMesh> {
     spec.validate()?;
-    let (l, r, d) = (spec.length, spec.radius, spec.head_depth);
+    let (l, d) = (spec.length, spec.head_depth);
     let h = spec.liquid_depth();
+    let mut mesh = tank_block(spec, h, (None, None), spec.n_length, spec.grading);
+    mesh.kind = format!("cylinder tank L={l} R={} head={d} fill={}", spec.radius, spec.fill);
+    Ok(mesh)
+}
+
+/// The liquid of a tank car between two axial ends, each either a head (`None`) or a
+/// bulkhead face at the given x: each axial fibre through a cross-section point runs from
+/// one end to the other, `n` elements long with the given grading. The exact volume is that
+/// of the tank interior between the ends, below the free surface at depth `h`.
+fn tank_block(spec: &CylinderTankSpec, h: f64, ends: (Option<f64>, Option<f64>), n: usize, grading: f64) -> FluidMesh {
+    let (l, r, d) = (spec.length, spec.radius, spec.head_depth);
+    let (a, b) = ends;
     let zs = h - r;
     let section = segment_map(r, r, zs);
-    let ltot = l + 2.0 * d;
     let width = 2.0 * r;
-    let u = graded_nodes(spec.n_length, ltot, spec.grading);
+    let len = b.unwrap_or(0.5 * l + d) - a.unwrap_or(-0.5 * l - d);
+    let u = graded_nodes(n, len, grading);
     let v = graded_nodes(spec.n_width, width, 1.0);
     let w = graded_nodes(spec.n_height, h, 1.0);
     let map = move |p: [f64; 3]| {
         let (y, z) = section(p[1] / width, p[2] / h);
         let rho2 = ((y * y + z * z) / (r * r)).min(1.0);
         let xh = 0.5 * l + d * (1.0 - rho2).sqrt();
-        let x = -xh + (p[0] / ltot) * 2.0 * xh;
-        [x, y, z]
+        let x0 = a.unwrap_or(-xh);
+        let x1 = b.unwrap_or(xh);
+        [x0 + (p[0] / len) * (x1 - x0), y, z]
     };
-    let exact = spec.fill * spec.tank_volume();
-    Ok(structured(&u, &v, &w, map, true, exact, zs, format!("cylinder tank L={l} R={r} head={d} fill={}", spec.fill)))
+    // each head end holds half of the ellipsoid (d, r, r) below the free surface
+    let head = |e: Option<f64>| {
+        if e.is_none() { 0.5 * (d / r) * std::f64::consts::PI * h * h * (3.0 * r - h) / 3.0 } else { 0.0 }
+    };
+    let shell = b.unwrap_or(0.5 * l) - a.unwrap_or(-0.5 * l);
+    let exact = shell * circle_segment_area(r, h) + head(a) + head(b);
+    structured(&u, &v, &w, map, true, exact, zs, String::new())
 }
 
 /// Specification of the liquid in a flat-ended cylinder of elliptical section
@@ -525,8 +543,6 @@ pub fn cylinder_tank_compartments(spec: &CylinderTankSpec, bulkheads: &[(f64, f6
         cuts.push((x, t));
     }
     let h = spec.liquid_depth();
-    let zs = h - r;
-    let width = 2.0 * r;
     // compartment ends: None = head surface
     let mut ends: Vec<(Option<f64>, Option<f64>)> = Vec::new();
     let mut lo = None;
@@ -538,31 +554,10 @@ pub fn cylinder_tank_compartments(spec: &CylinderTankSpec, bulkheads: &[(f64, f6
     let nominal = |e: Option<f64>, sign: f64| e.unwrap_or(sign * ltot / 2.0);
     let lens: Vec<f64> = ends.iter().map(|(a, b)| nominal(*b, 1.0) - nominal(*a, -1.0)).collect();
     let total: f64 = lens.iter().sum();
-    let mut blocks = Vec::new();
-    for ((a, b), len) in ends.iter().zip(&lens) {
-        let n = ((spec.n_length as f64 * len / total).round() as usize).max(1);
-        let (a, b) = (*a, *b);
-        let u = graded_nodes(n, *len, 1.0);
-        let v = graded_nodes(spec.n_width, width, 1.0);
-        let w = graded_nodes(spec.n_height, h, 1.0);
-        let len = *len;
-        let section = segment_map(r, r, zs);
-        let map = move |p: [f64; 3]| {
-            let (y, z) = section(p[1] / width, p[2] / h);
-            let rho2 = ((y * y + z * z) / (r * r)).min(1.0);
-            let xh = 0.5 * l + d * (1.0 - rho2).sqrt();
-            let x0 = a.unwrap_or(-xh);
-            let x1 = b.unwrap_or(xh);
-            [x0 + (p[0] / len) * (x1 - x0), y, z]
-        };
-        // exact volume of the compartment below the free surface
-        let seg = circle_segment_area(r, h);
-        let heads = |e: Option<f64>| {
-            if e.is_none() { 0.5 * (d / r) * std::f64::consts::PI * h * h * (3.0 * r - h) / 3.0 } else { 0.0 }
-        };
-        let shell = b.unwrap_or(l / 2.0) - a.unwrap_or(-l / 2.0);
-        let exact = shell * seg + heads(a) + heads(b);
-        blocks.push(structured(&u, &v, &w, map, true, exact, zs, String::new()));
-    }
+    let blocks = ends
+        .iter()
+        .zip(&lens)
+        .map(|(&e, len)| tank_block(spec, h, e, ((spec.n_length as f64 * len / total).round() as usize).max(1), 1.0))
+        .collect();
     Ok(merge(blocks, format!("cylinder tank L={l} R={r} head={d} fill={} with {} bulkheads", spec.fill, cuts.len())))
 }

@@ -15,6 +15,7 @@
 use std::collections::HashMap;
 
 use ancf_core::FluidBody;
+use ancf_core::constitutive::M3;
 use ancf_core::contact::{ContactLoad, PointJacobian, TankKinematics, WallContact};
 use ancf_core::error::AncfError;
 use ancf_core::shape::N_SHAPE;
@@ -141,6 +142,27 @@ impl SloshSystem {
         )
     }
 
+    /// In the tank-frame formulation with a rotating tank, the matrices of the rotational
+    /// pseudo-accelerations −(ω̃̇ + ω̃²) r − 2 ω̃ ṙ (tank components): (ω̃̇ + ω̃², 2 ω̃).
+    fn rotation_terms(&self, t: f64) -> Option<(M3, M3)> {
+        if self.frame != SloshFrame::Tank {
+            return None;
+        }
+        let (_, _, w, wd) = self.tank_frame_terms(t);
+        if w.norm() == 0.0 && wd.norm() == 0.0 {
+            return None;
+        }
+        let wx = w.cross_matrix();
+        Some((wd.cross_matrix() + wx * wx, 2.0 * wx))
+    }
+
+    /// Pattern index of entry (compact 3a + i, compact 3b + k) of an element whose node-pair
+    /// blocks start at `eb`.
+    #[inline]
+    fn element_index(eb: &[usize; 64], a: usize, i: usize, b: usize, k: usize) -> usize {
+        eb[8 * (a / 4) + b / 4] + (3 * (a % 4) + i) * 12 + 3 * (b % 4) + k
+    }
+
     /// Contact load on the tank at a state (global components in the inertial formulation,
     /// tank components in the tank-frame formulation).
     pub fn contact_load(&self, t: f64, q: &[f64], v: &[f64]) -> ContactLoad {
@@ -179,9 +201,12 @@ impl MechanicalSystem for SloshSystem {
         self.body.internal_forces(q, v, out).map_err(sys_err)?;
         out.iter_mut().for_each(|x| *x = -*x);
         let gs = self.body.gravity_scale();
-        let (g, alin, w, wd) = match self.frame {
-            SloshFrame::Inertial => (Vector3::from(self.gravity), Vector3::zeros(), Vector3::zeros(), Vector3::zeros()),
-            SloshFrame::Tank => self.tank_frame_terms(t),
+        let (g, alin) = match self.frame {
+            SloshFrame::Inertial => (Vector3::from(self.gravity), Vector3::zeros()),
+            SloshFrame::Tank => {
+                let (g, alin, _, _) = self.tank_frame_terms(t);
+                (g, alin)
+            }
         };
         let acc = g - alin;
         for (s, o) in gs.iter().zip(out.chunks_exact_mut(3)) {
@@ -189,9 +214,7 @@ impl MechanicalSystem for SloshSystem {
                 o[i] += s * acc[i];
             }
         }
-        if self.frame == SloshFrame::Tank && (w.norm() > 0.0 || wd.norm() > 0.0) {
-            let b = wd.cross_matrix() + w.cross_matrix() * w.cross_matrix();
-            let wc = 2.0 * w.cross_matrix();
+        if let Some((b, wc)) = self.rotation_terms(t) {
             let m = self.body.scalar_mass().as_ref();
             for j in 0..m.ncols() {
                 let ej = Vector3::new(q[3 * j], q[3 * j + 1], q[3 * j + 2]);
@@ -225,11 +248,10 @@ impl MechanicalSystem for SloshSystem {
             let eb = &self.element_blocks[el];
             for a in 0..N_SHAPE {
                 for b in 0..N_SHAPE {
-                    let start = eb[8 * (a / 4) + b / 4];
                     for i in 0..3 {
                         let row = 96 * (3 * a + i);
                         for k in 0..3 {
-                            let idx = start + (3 * (a % 4) + i) * 12 + 3 * (b % 4) + k;
+                            let idx = Self::element_index(eb, a, i, b, k);
                             dq[idx] -= jac.stiffness[row + 3 * b + k];
                             dv[idx] -= jac.damping[row + 3 * b + k];
                         }
@@ -237,20 +259,15 @@ impl MechanicalSystem for SloshSystem {
                 }
             }
         }
-        if self.frame == SloshFrame::Tank {
-            let (_, _, w, wd) = self.tank_frame_terms(t);
-            if w.norm() > 0.0 || wd.norm() > 0.0 {
-                let b = wd.cross_matrix() + w.cross_matrix() * w.cross_matrix();
-                let wc = 2.0 * w.cross_matrix();
-                let m = self.body.scalar_mass().as_ref();
-                for j in 0..m.ncols() {
-                    for (i, val) in m.row_idx_of_col(j).zip(m.val_of_col(j)) {
-                        for r in 0..3 {
-                            for c in 0..3 {
-                                let idx = self.value_index(3 * i + r, 3 * j + c);
-                                dq[idx] -= val * b[(r, c)];
-                                dv[idx] -= val * wc[(r, c)];
-                            }
+        if let Some((b, wc)) = self.rotation_terms(t) {
+            let m = self.body.scalar_mass().as_ref();
+            for j in 0..m.ncols() {
+                for (i, val) in m.row_idx_of_col(j).zip(m.val_of_col(j)) {
+                    for r in 0..3 {
+                        for c in 0..3 {
+                            let idx = self.value_index(3 * i + r, 3 * j + c);
+                            dq[idx] -= val * b[(r, c)];
+                            dv[idx] -= val * wc[(r, c)];
                         }
                     }
                 }
@@ -269,10 +286,9 @@ impl MechanicalSystem for SloshSystem {
                     if nn == 0.0 {
                         continue;
                     }
-                    let start = eb[8 * (a / 4) + b / 4];
                     for i in 0..3 {
                         for k in 0..3 {
-                            let idx = start + (3 * (a % 4) + i) * 12 + 3 * (b % 4) + k;
+                            let idx = Self::element_index(eb, a, i, b, k);
                             dq[idx] += nn * p.d_position[(i, k)];
                             dv[idx] += nn * p.d_velocity[(i, k)];
                         }
