@@ -55,6 +55,10 @@ pub enum AncfError {
         /// Element index.
         element: usize,
     },
+    /// A simulation run by a validation case or driver stopped (the message says where
+    /// and why: time, element, contact).
+    #[error("simulation failed: {0}")]
+    Solver(String),
 }
 
 /// Result alias for `ancf-core`.

@@ -9,7 +9,9 @@
 #![warn(missing_docs)]
 
 pub mod integrator;
+pub mod mbs;
 pub mod profile;
 pub mod slosh;
 pub mod track;
+pub mod vehicle;
 pub mod wheel_rail;

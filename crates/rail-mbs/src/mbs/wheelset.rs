@@ -1,0 +1,57 @@
+//! Wheel/rail contact of a wheelset body: both wheels against their rails (ECF-A,
+//! [`crate::wheel_rail`]), as a force element on the wheelset.
+
+use nalgebra::Vector3;
+
+use super::body::{BodyId, BodyState};
+use super::force::Wrench;
+use crate::wheel_rail::{ContactError, ContactPoint, WheelPose, WheelRailContact};
+
+/// Contact of one wheelset with the two rails.
+#[derive(Debug, Clone)]
+pub struct WheelsetContact {
+    /// Name (e.g. "car1/bogie1/wheelset1").
+    pub name: String,
+    /// The wheelset body.
+    pub body: BodyId,
+    /// Left wheel on the left rail, and right wheel on the right rail.
+    pub wheels: [WheelRailContact; 2],
+}
+
+/// Contact points of one wheelset at one instant.
+#[derive(Debug, Clone, Default)]
+pub struct WheelsetReport {
+    /// Loaded contact points of the left and right wheels.
+    pub points: [Vec<ContactPoint>; 2],
+}
+
+impl WheelsetReport {
+    /// Sum of the contact forces on a wheel (0 = left, 1 = right), global, N.
+    pub fn wheel_force(&self, side: usize) -> Vector3<f64> {
+        self.points[side].iter().map(|p| p.force_on_wheel()).sum()
+    }
+}
+
+fn pose(s: &BodyState) -> WheelPose {
+    WheelPose { position: s.position, rotation: s.rotation, velocity: s.velocity, angular_velocity: s.angular_velocity }
+}
+
+impl WheelsetContact {
+    /// Contact points of both wheels at `state` (updates the warm start).
+    pub fn evaluate(&mut self, state: &BodyState) -> Result<WheelsetReport, ContactError> {
+        let p = pose(state);
+        let [l, r] = &mut self.wheels;
+        Ok(WheelsetReport { points: [l.evaluate(&p)?, r.evaluate(&p)?] })
+    }
+
+    /// Total contact wrench on the wheelset about its centre of mass.
+    pub fn wrench(&mut self, state: &BodyState) -> Result<Wrench, ContactError> {
+        let rep = self.evaluate(state)?;
+        let mut w = Wrench::default();
+        for p in rep.points.iter().flatten() {
+            w.force += p.force_on_wheel();
+            w.moment += p.moment_on_wheel(&state.position);
+        }
+        Ok(w)
+    }
+}

@@ -1,0 +1,44 @@
+//! Vehicle builders: the freight tank car of seed 000 §8.1 (Fig. 7) and trains of such
+//! cars joined by couplers.
+//!
+//! # The tank car
+//!
+//! Fifteen rigid bodies: the tank (car body), two stub sills welded to it, and two
+//! bogies (trucks), each with a bolster, a frame, two equalizers and two wheelsets.
+//! Connections, as in seed 000 §8.1:
+//!
+//! | connection | model |
+//! |---|---|
+//! | stub sill – tank | fixed joint (6 equations each) |
+//! | bolster – frame | pin: revolute joint about the vertical (5 equations each) |
+//! | wheelset – frame (primary suspension) | one bushing per axle box, translational |
+//! | wheelset – equalizer (journal bearing) | one bushing per bearing, spin free |
+//! | bolster – stub sill (secondary suspension) | one bushing per side |
+//! | wheelset – rails | ECF-A wheel/rail contact, Hertz + creep ([`crate::wheel_rail`]) |
+//!
+//! The car has 15 × 6 − 2 × 6 − 2 × 5 = **68 degrees of freedom**. The paper reports
+//! 73 for its model without listing its joints; the five-DOF difference cannot be
+//! traced from the text (it may model the journal bearings or pins differently).
+//!
+//! Every parameter is a field of [`TankCarParams`]; the defaults and their sources are
+//! listed there. Suspension springs carry their static share of the car weight as a
+//! preload at the assembled (reference) configuration, so a car placed on level track
+//! starts in equilibrium except for the Hertzian contact deflection.
+//!
+//! # Placement
+//!
+//! A car is placed on a [`Track`] with its tank centre at arc length `s`: every body
+//! sits at its own station, in the local track frame (tangent, left, up, banked by the
+//! super-elevation), and moves initially with the speed `V` along the tangent, the yaw
+//! rate `V κ`, and — wheelsets — the rolling spin `V / r₀`. The front of the car (bogie
+//! 1, coupler end A) points towards increasing `s`.
+
+mod run;
+mod tank_car;
+pub mod validate;
+
+pub use run::{BrakeScope, TrainFailure, TrainRecord, TrainScenario, build_train, run_train};
+pub use tank_car::{
+    BodyMass, CarBodies, CarPlacement, ContactParams, SuspensionParams, TankCarParams, WheelLoad, add_coupler,
+    add_tank_car, wheel_loads,
+};

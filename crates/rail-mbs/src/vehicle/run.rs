@@ -1,0 +1,306 @@
+//! Running trains of tank cars (rigid lading) on a track and recording wheel loads,
+//! derailment indicators and coupler forces.
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use nalgebra::Vector3;
+
+use super::tank_car::{CarBodies, CarPlacement, TankCarParams, add_coupler, add_tank_car, wheel_loads};
+use crate::integrator::{AdaptiveParams, Hht, HhtParams, IntegratorError, StepControl};
+use crate::mbs::{Multibody, SpeedProfile, Table};
+use crate::track::Track;
+use ancf_core::error::{AncfError, check_positive, invalid};
+
+/// Which cars brake.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BrakeScope {
+    /// Every wheelset of every car at once (ECP braking).
+    AllCars,
+    /// Only the front car (conventional braking as modelled in seed 000 §8.2).
+    FrontCar,
+}
+
+/// A train scenario: `n` identical tank cars coupled front to rear on a track.
+#[derive(Debug, Clone)]
+pub struct TrainScenario {
+    /// Number of cars (≥ 1).
+    pub cars: usize,
+    /// Car parameters.
+    pub car: TankCarParams,
+    /// Track.
+    pub track: Arc<Track>,
+    /// Arc length of the front car's tank centre at `t = 0`, m.
+    pub station: f64,
+    /// Initial speed, m/s.
+    pub speed: f64,
+    /// Speed profile the front car is held to by a trajectory joint, if any.
+    pub drive: Option<SpeedProfile>,
+    /// Brake torque per wheelset (N·m against s) and which cars brake.
+    pub brake: Option<(Table, BrakeScope)>,
+    /// Coupler stiffness and damping (defaults of seed 000 §8.2 when `None`).
+    pub coupler: (Option<f64>, Option<f64>),
+    /// Initial lateral displacement of every wheelset (a disturbance), m.
+    pub wheelset_lateral_offset: f64,
+    /// End time, s.
+    pub t_end: f64,
+    /// (Maximum) step, s.
+    pub step: f64,
+    /// Recording interval, s.
+    pub record_every: f64,
+    /// Integrator parameters.
+    pub hht: HhtParams,
+}
+
+impl TrainScenario {
+    /// Integrator defaults for vehicles: α = −0.3, adaptive steps.
+    pub fn default_hht() -> HhtParams {
+        HhtParams {
+            alpha: -0.3,
+            rel_tol: 1e-4,
+            abs_tol_acc: 1e-3,
+            abs_tol_lambda: 1e-1,
+            max_iterations: 10,
+            step_control: StepControl::Adaptive(AdaptiveParams {
+                h_min: 1e-7,
+                easy_iterations: 5,
+                ..Default::default()
+            }),
+            ..Default::default()
+        }
+    }
+
+    /// One car on `track` at `station`, moving at `speed`.
+    pub fn single(car: TankCarParams, track: Arc<Track>, station: f64, speed: f64, t_end: f64) -> Self {
+        Self {
+            cars: 1,
+            car,
+            track,
+            station,
+            speed,
+            drive: None,
+            brake: None,
+            coupler: (None, None),
+            wheelset_lateral_offset: 0.0,
+            t_end,
+            step: 1e-3,
+            record_every: 0.01,
+            hht: Self::default_hht(),
+        }
+    }
+
+    /// Checks the scenario fields.
+    pub fn validate(&self) -> Result<(), AncfError> {
+        if self.cars == 0 || self.cars > 50 {
+            return Err(invalid("cars", self.cars, "1 to 50"));
+        }
+        check_positive("t_end", self.t_end)?;
+        check_positive("step", self.step)?;
+        check_positive("record_every", self.record_every)?;
+        if !(self.speed.is_finite() && self.speed.abs() < 100.0) {
+            return Err(invalid("speed", self.speed, "|speed| < 100 m/s"));
+        }
+        if !(self.wheelset_lateral_offset.is_finite() && self.wheelset_lateral_offset.abs() < 0.01) {
+            return Err(invalid("wheelset_lateral_offset", self.wheelset_lateral_offset, "|offset| < 0.01 m"));
+        }
+        self.hht.validate().map_err(|e| invalid("hht", e, "valid integrator parameters"))?;
+        Ok(())
+    }
+}
+
+/// Recorded results of a train run. Arrays are indexed `[sample][...]`.
+#[derive(Debug, Clone, Default)]
+pub struct TrainRecord {
+    /// Times, s.
+    pub t: Vec<f64>,
+    /// Vertical wheel load `Q`, N: `[sample][wheelset][left, right]`, wheelsets front to
+    /// rear over all cars.
+    pub wheel_vertical: Vec<Vec<[f64; 2]>>,
+    /// Lateral wheel force `Y` (track-left positive), N, same layout.
+    pub wheel_lateral: Vec<Vec<[f64; 2]>>,
+    /// Lateral displacement of each wheelset from the centreline, m: `[sample][wheelset]`.
+    pub wheelset_lateral: Vec<Vec<f64>>,
+    /// Coupler forces (tension positive), N: `[sample][coupler]`.
+    pub coupler_force: Vec<Vec<f64>>,
+    /// Tank-centre arc length along the track, m: `[sample][car]`.
+    pub tank_station: Vec<Vec<f64>>,
+    /// Tank speed, m/s: `[sample][car]`.
+    pub tank_speed: Vec<Vec<f64>>,
+    /// Static wheel load on level track, N.
+    pub static_wheel_load: f64,
+    /// Newton iterations, steps, rejected steps, Jacobian evaluations.
+    pub newton_iterations: usize,
+    /// Accepted steps.
+    pub steps: usize,
+    /// Rejected steps.
+    pub rejected_steps: usize,
+    /// Jacobian evaluations.
+    pub jacobian_evaluations: usize,
+    /// Wall time, s.
+    pub wall_time: f64,
+    /// Degrees of freedom of the model.
+    pub dof: isize,
+}
+
+impl TrainRecord {
+    /// Mean over samples with `t ≥ t0` of the vertical load of `(wheelset, side)`.
+    pub fn mean_vertical(&self, t0: f64, wheelset: usize, side: usize) -> f64 {
+        let v: Vec<f64> = self
+            .t
+            .iter()
+            .zip(&self.wheel_vertical)
+            .filter(|(t, _)| **t >= t0)
+            .map(|(_, q)| q[wheelset][side])
+            .collect();
+        v.iter().sum::<f64>() / v.len().max(1) as f64
+    }
+
+    /// `L/V = |Y|/Q` per wheel: `[sample][wheelset][side]` (0 where unloaded).
+    pub fn l_over_v(&self) -> Vec<Vec<[f64; 2]>> {
+        self.wheel_vertical
+            .iter()
+            .zip(&self.wheel_lateral)
+            .map(|(q, y)| {
+                q.iter().zip(y).map(|(q, y)| [0, 1].map(|s| if q[s] > 0.0 { y[s].abs() / q[s] } else { 0.0 })).collect()
+            })
+            .collect()
+    }
+
+    /// Wheel unloading ratio `ΔQ/Q₀ = (Q₀ − Q)/Q₀`: `[sample][wheelset][side]`.
+    pub fn unloading(&self) -> Vec<Vec<[f64; 2]>> {
+        let q0 = self.static_wheel_load;
+        self.wheel_vertical.iter().map(|q| q.iter().map(|q| [0, 1].map(|s| (q0 - q[s]) / q0)).collect()).collect()
+    }
+}
+
+/// A run that stopped early: the error and what was recorded up to it.
+#[derive(Debug)]
+pub struct TrainFailure {
+    /// Why it stopped.
+    pub error: IntegratorError,
+    /// Results up to the failure.
+    pub record: TrainRecord,
+}
+
+/// Builds the multibody model of a scenario; returns it with the cars and couplers.
+pub fn build_train(sc: &TrainScenario) -> Result<(Multibody, Vec<CarBodies>, Vec<usize>), AncfError> {
+    sc.validate()?;
+    let mut mb = Multibody::new();
+    let mut cars = Vec::with_capacity(sc.cars);
+    let pitch = 2.0 * sc.car.coupler_reach + 1.0;
+    for k in 0..sc.cars {
+        let brake = match &sc.brake {
+            Some((t, BrakeScope::AllCars)) => Some(t.clone()),
+            Some((t, BrakeScope::FrontCar)) if k == 0 => Some(t.clone()),
+            _ => None,
+        };
+        let drive = if k == 0 { sc.drive.clone() } else { None };
+        let station = sc.station - pitch * k as f64;
+        let placement = CarPlacement { station, speed: sc.speed, drive, brake };
+        cars.push(add_tank_car(&mut mb, &format!("car{}", k + 1), &sc.car, &sc.track, placement)?);
+    }
+    if sc.wheelset_lateral_offset != 0.0 {
+        // Displace every wheelset laterally (along the local track-left axis).
+        for car in &cars {
+            for ws in car.wheelsets {
+                mb.displace_body(ws, sc.track.frame(car.station).lateral() * sc.wheelset_lateral_offset)?;
+            }
+        }
+    }
+    let mut couplers = Vec::new();
+    for k in 1..sc.cars {
+        let (c1, c2) = (&cars[k - 1], &cars[k]);
+        couplers.push(add_coupler(&mut mb, &format!("coupler{k}"), &sc.car, c1, c2, sc.coupler.0, sc.coupler.1)?);
+    }
+    Ok((mb, cars, couplers))
+}
+
+fn record_sample(
+    hht: &mut Hht<Multibody>,
+    track: &Track,
+    cars: &[CarBodies],
+    couplers: &[usize],
+    hints: &mut [f64],
+    rec: &mut TrainRecord,
+) -> Result<(), IntegratorError> {
+    let (q, v) = (hht.q().to_vec(), hht.v().to_vec());
+    let t = hht.t();
+    let reps = hht.system_mut().wheelset_reports(&q, &v).map_err(|e| IntegratorError::System { t, source: e })?;
+    let mb = hht.system();
+    let mut qv = Vec::new();
+    let mut yv = Vec::new();
+    let mut lat = Vec::new();
+    for car in cars {
+        for (w, ws) in car.wheelsets.iter().enumerate() {
+            let s = mb.state(Some(*ws), &q, &v);
+            let k = car.contacts[w];
+            let proj = track.project(&s.position, Some(hints[k])).ok();
+            let (up, left, y) = match proj {
+                Some(p) => {
+                    hints[k] = p.s;
+                    let f = track.frame(p.s);
+                    (f.up(), f.lateral(), p.lateral)
+                }
+                None => (Vector3::z(), Vector3::y(), f64::NAN),
+            };
+            let wl = wheel_loads(&reps[k], &up, &left);
+            qv.push([wl[0].vertical, wl[1].vertical]);
+            yv.push([wl[0].lateral, wl[1].lateral]);
+            lat.push(y);
+        }
+    }
+    let forces = mb.force_outputs(t, &q, &v);
+    rec.t.push(t);
+    rec.wheel_vertical.push(qv);
+    rec.wheel_lateral.push(yv);
+    rec.wheelset_lateral.push(lat);
+    rec.coupler_force.push(couplers.iter().map(|&c| forces[c]).collect());
+    let mut st = Vec::new();
+    let mut sp = Vec::new();
+    for car in cars {
+        let s = mb.state(Some(car.tank), &q, &v);
+        st.push(track.project(&s.position, Some(car.station)).map_or(f64::NAN, |p| p.s));
+        sp.push(s.velocity.norm());
+    }
+    rec.tank_station.push(st);
+    rec.tank_speed.push(sp);
+    Ok(())
+}
+
+/// Runs a scenario; on failure returns what was recorded so far with the error.
+pub fn run_train(sc: &TrainScenario) -> Result<Result<TrainRecord, Box<TrainFailure>>, AncfError> {
+    let (mb, cars, couplers) = build_train(sc)?;
+    let mut rec = TrainRecord { static_wheel_load: cars[0].static_wheel_load, dof: mb.dof(), ..Default::default() };
+    let (q0, v0) = mb.initial_coordinates();
+    let start = Instant::now();
+    let finish = |hht: Option<&Hht<Multibody>>, mut rec: TrainRecord| {
+        if let Some(h) = hht {
+            let s = h.stats();
+            rec.newton_iterations = s.newton_iterations;
+            rec.steps = s.steps;
+            rec.rejected_steps = s.rejected_steps;
+            rec.jacobian_evaluations = s.jacobian_evaluations;
+        }
+        rec.wall_time = start.elapsed().as_secs_f64();
+        rec
+    };
+    let mut hht = match Hht::new(mb, 0.0, q0, v0, sc.hht) {
+        Ok(h) => h,
+        Err(error) => return Ok(Err(Box::new(TrainFailure { error, record: finish(None, rec) }))),
+    };
+    let mut hints: Vec<f64> = cars.iter().flat_map(|c| [c.station; 4]).collect();
+    let n_rec = (sc.t_end / sc.record_every).round() as usize;
+    for k in 0..=n_rec {
+        let target = (k as f64 * sc.record_every).min(sc.t_end);
+        while hht.t() < target - 1e-12 {
+            let h = sc.step.min(target - hht.t());
+            if let Err(error) = hht.step(h) {
+                return Ok(Err(Box::new(TrainFailure { error, record: finish(Some(&hht), rec) })));
+            }
+        }
+        if let Err(error) = record_sample(&mut hht, &sc.track, &cars, &couplers, &mut hints, &mut rec) {
+            return Ok(Err(Box::new(TrainFailure { error, record: finish(Some(&hht), rec) })));
+        }
+    }
+    Ok(Ok(finish(Some(&hht), rec)))
+}

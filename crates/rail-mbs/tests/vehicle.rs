@@ -1,0 +1,70 @@
+//! Vehicle model: DOF count, static wheel loads on tangent track, a two-car train whose
+//! braked front car compresses the coupler, and bad input.
+
+use std::sync::Arc;
+
+use rail_mbs::mbs::Table;
+use rail_mbs::track::{Track, TrackPoint};
+use rail_mbs::vehicle::{BrakeScope, TankCarParams, TrainScenario, build_train, run_train, validate};
+
+fn tangent() -> Arc<Track> {
+    Arc::new(
+        Track::new(vec![TrackPoint::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0), TrackPoint::new(3000.0, 0.0, 0.0, 0.0, 0.0, 0.0)])
+            .unwrap(),
+    )
+}
+
+#[test]
+fn tank_car_and_train_have_the_documented_structure() {
+    let sc = TrainScenario::single(TankCarParams::standard().unwrap(), tangent(), 100.0, 0.0, 1.0);
+    let (mb, cars, couplers) = build_train(&sc).unwrap();
+    assert_eq!(mb.bodies().len(), 15);
+    assert_eq!(mb.dof(), 68);
+    assert!(couplers.is_empty());
+    assert_eq!(cars[0].wheelsets.len(), 4);
+    let mut two = sc.clone();
+    two.cars = 2;
+    let (mb, _, couplers) = build_train(&two).unwrap();
+    assert_eq!(mb.dof(), 136);
+    assert_eq!(couplers.len(), 1);
+}
+
+#[test]
+fn static_wheel_loads_case_passes_quick() {
+    let recs = validate::run_case("static-wheel-loads", true).unwrap();
+    for r in &recs {
+        println!("{}: {} (limit {})", r.quantity, r.measured, r.tolerance);
+        assert!(r.passed, "{r:?}");
+    }
+}
+
+#[test]
+fn braking_the_front_car_compresses_the_coupler() {
+    let v = 20.0 / 3.6;
+    let mut sc = TrainScenario::single(TankCarParams::standard().unwrap(), tangent(), 100.0, v, 0.6);
+    sc.cars = 2;
+    sc.record_every = 0.05;
+    let torque = Table::new("brake", vec![0.0, 0.1], vec![0.0, 6000.0]).unwrap();
+    sc.brake = Some((torque, BrakeScope::FrontCar));
+    let rec = run_train(&sc).unwrap().unwrap();
+    let f: Vec<f64> = rec.coupler_force.iter().map(|c| c[0]).collect();
+    println!("coupler force {f:?}");
+    let late = &f[f.len() / 2..];
+    assert!(late.iter().all(|&x| x < 0.0), "coupler should be in compression: {late:?}");
+    // Both cars decelerate.
+    let s = &rec.tank_speed;
+    assert!(s.last().unwrap()[0] < v && s.last().unwrap()[1] < v);
+}
+
+#[test]
+fn bad_scenario_input_names_the_field() {
+    let mut sc = TrainScenario::single(TankCarParams::standard().unwrap(), tangent(), 100.0, 0.0, 1.0);
+    sc.cars = 0;
+    let e = build_train(&sc).unwrap_err().to_string();
+    assert!(e.contains("cars"), "{e}");
+    let mut p = TankCarParams::standard().unwrap();
+    p.wheelbase = 20.0;
+    let sc = TrainScenario::single(p, tangent(), 100.0, 0.0, 1.0);
+    let e = build_train(&sc).unwrap_err().to_string();
+    assert!(e.contains("wheelbase"), "{e}");
+}
