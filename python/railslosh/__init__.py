@@ -5,7 +5,7 @@ analysis and the ``railslosh`` command-line tool. Units are SI throughout; frame
 conventions are defined in ``docs/frames.md``.
 """
 
-from railslosh import fluids, mesh, slosh
+from railslosh import fluids, mesh, rail, slosh, vehicle
 from railslosh._core import (
     Fluid,
     FluidBody,
@@ -24,5 +24,7 @@ __all__ = [
     "fluids",
     "mass_matrix",
     "mesh",
+    "rail",
     "slosh",
+    "vehicle",
 ]

@@ -1,5 +1,6 @@
 """Type stubs of the Rust extension module ``railslosh._core``."""
 
+import os
 from typing import Any
 
 import numpy as np
@@ -9,6 +10,9 @@ __version__: str
 
 class RailsloshError(Exception):
     """Base class of railslosh simulation errors."""
+
+class DataNotFoundError(RailsloshError):
+    """External reference data (e.g. the Manchester contact benchmark) were not found; the case is skipped."""
 
 class FluidMesh:
     """A structured ANCF fluid mesh (reference configuration, tank frame)."""
@@ -142,3 +146,135 @@ def run_slosh(
 ) -> dict[str, Any]: ...
 def run_validation(name: str, quick: bool = False) -> list[dict[str, Any]]: ...
 def _panic_for_test() -> None: ...
+
+_F64 = npt.NDArray[np.float64]
+
+class Track:
+    """Track geometry from a segment table (columns of equal length; see railslosh.rail.Track)."""
+
+    def __init__(
+        self,
+        s: _F64,
+        curvature: _F64,
+        superelevation: _F64,
+        grade: _F64,
+        cant_right: _F64,
+        cant_left: _F64,
+        *,
+        units: str = "si",
+        gauge: float = 1.435,
+        cant_base: float = 1.5,
+        origin: tuple[float, float, float] = (0.0, 0.0, 0.0),
+        heading: float = 0.0,
+    ) -> None: ...
+    @property
+    def gauge(self) -> float: ...
+    @property
+    def cant_base(self) -> float: ...
+    @property
+    def range(self) -> tuple[float, float]: ...
+    @property
+    def table(self) -> _F64: ...
+    @property
+    def units(self) -> str: ...
+    def position(self, s: _F64) -> _F64: ...
+    def tangent(self, s: _F64) -> _F64: ...
+    def frame(self, s: _F64) -> tuple[_F64, _F64]: ...
+    def curvature(self, s: _F64) -> _F64: ...
+    def superelevation(self, s: _F64) -> _F64: ...
+    def grade(self, s: _F64) -> _F64: ...
+    def heading(self, s: _F64) -> _F64: ...
+    def bank_angle(self, s: _F64) -> _F64: ...
+    def balance_speed(self, s: _F64) -> _F64: ...
+    def rail_point(self, s: _F64, side: str) -> _F64: ...
+    def rail_inward_cant(self, s: _F64, side: str) -> _F64: ...
+    def project(self, points: _F64) -> tuple[_F64, _F64, _F64]: ...
+
+class Profile:
+    """A wheel or rail profile z(y) (m; y towards the field side, z up)."""
+
+    @staticmethod
+    def s1002(spacing: float = 2e-4) -> Profile: ...
+    @staticmethod
+    def uic60(spacing: float = 2e-4) -> Profile: ...
+    @staticmethod
+    def aar1b_approx() -> Profile: ...
+    @staticmethod
+    def from_simpack(path: str | os.PathLike[str]) -> Profile: ...
+    @staticmethod
+    def from_points(y: _F64, z: _F64, name: str = "points", kind: str | None = None) -> Profile: ...
+    @staticmethod
+    def from_two_column(
+        path: str | os.PathLike[str],
+        *,
+        scale: float = 1.0,
+        z_down: bool = False,
+        mirror_y: bool = False,
+        kind: str | None = None,
+    ) -> Profile: ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def kind(self) -> str | None: ...
+    @property
+    def y_range(self) -> tuple[float, float]: ...
+    @property
+    def knots(self) -> _F64: ...
+    def highest_point(self) -> tuple[float, float]: ...
+    def sample(self, n: int) -> _F64: ...
+    def eval(self, y: _F64) -> tuple[_F64, _F64, _F64]: ...
+    def trim_steep_ends(self, max_slope: float) -> Profile: ...
+
+def wheel_rail_contact(
+    wheel: Profile,
+    rail: Profile,
+    *,
+    side: str = "left",
+    nominal_radius: float = 0.46,
+    wheel_offset: float = 0.75,
+    rail_offset: float | None = None,
+    gauge: float = 1.435,
+    gauge_depth: float = 0.014,
+    rail_cant: float = 0.0,
+    trim_slope: float | None = None,
+    lateral_shift: float = 0.0,
+    yaw: float = 0.0,
+    roll: float = 0.0,
+    load: float | None = None,
+    penetration: float | None = None,
+    speed: float = 0.0,
+    lateral_velocity: float = 0.0,
+    yaw_rate: float = 0.0,
+    axle_rate: float | None = None,
+    creepages: tuple[float, float, float] | None = None,
+    creep_model: str = "shen-hedrick-elkins",
+    friction: float = 0.3,
+    young: float = 2.1e11,
+    poisson: float = 0.3,
+    scan_points: int = 400,
+) -> dict[str, Any]: ...
+
+# --- vehicle (crates/railslosh-py/src/vehicle.rs) ---
+
+def tank_car_parameters(car: dict[str, float] | None = None, wheel_profile: str = "s1002") -> dict[str, Any]: ...
+def run_train(
+    track: list[list[float]],
+    *,
+    cars: int = 1,
+    station: float = 50.0,
+    speed: float = 0.0,
+    t_end: float = 1.0,
+    step: float = 1e-3,
+    record_every: float = 0.01,
+    drive_speed: float | None = None,
+    brake_times: list[float] | None = None,
+    brake_torques: list[float] | None = None,
+    brake_scope: str = "all",
+    lading_mass: float = 0.0,
+    lading_height: float = 0.0,
+    wheel_profile: str = "s1002",
+    wheelset_lateral_offset: float = 0.0,
+    coupler_stiffness: float | None = None,
+    coupler_damping: float | None = None,
+    car: dict[str, float] | None = None,
+) -> dict[str, Any]: ...

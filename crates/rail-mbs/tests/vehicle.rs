@@ -9,8 +9,11 @@ use rail_mbs::vehicle::{BrakeScope, TankCarParams, TrainScenario, build_train, r
 
 fn tangent() -> Arc<Track> {
     Arc::new(
-        Track::new(vec![TrackPoint::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0), TrackPoint::new(3000.0, 0.0, 0.0, 0.0, 0.0, 0.0)])
-            .unwrap(),
+        Track::new(vec![
+            TrackPoint::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+            TrackPoint::new(3000.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+        ])
+        .unwrap(),
     )
 }
 

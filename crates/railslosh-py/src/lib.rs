@@ -10,6 +10,9 @@
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
+mod rail;
+mod vehicle;
+
 use ancf_core::body::FluidBody;
 use ancf_core::constitutive::{Fluid, Rheology};
 use ancf_core::element::QuadratureOptions;
@@ -504,20 +507,33 @@ fn run_slosh<'py>(
 /// Names of the validation cases implemented in Rust.
 #[pyfunction]
 fn validation_cases() -> Vec<&'static str> {
-    ancf_core::validate::CASES.iter().chain(rail_mbs::slosh::validate::CASES.iter()).copied().collect()
+    ancf_core::validate::CASES
+        .iter()
+        .chain(rail_mbs::slosh::validate::CASES.iter())
+        .chain(rail_mbs::wheel_rail::validate::CASES.iter())
+        .chain(rail_mbs::vehicle::validate::CASES.iter())
+        .copied()
+        .collect()
 }
 
 /// Run one validation case; returns a list of dict records.
 #[pyfunction]
 #[pyo3(signature = (name, quick=false))]
 fn run_validation<'py>(py: Python<'py>, name: String, quick: bool) -> PyResult<Vec<Bound<'py, PyDict>>> {
-    let recs = compute(py, move || {
-        if rail_mbs::slosh::validate::CASES.contains(&name.as_str()) {
-            rail_mbs::slosh::validate::run_case(&name, quick)
-        } else {
-            ancf_core::validate::run_case(&name, quick)
-        }
-    })?;
+    let recs = if rail_mbs::wheel_rail::validate::CASES.contains(&name.as_str()) {
+        // Missing external data raise `DataNotFoundError` (reported as skipped).
+        rail::run_contact_validation(py, name, quick)?
+    } else {
+        compute(py, move || {
+            if rail_mbs::slosh::validate::CASES.contains(&name.as_str()) {
+                rail_mbs::slosh::validate::run_case(&name, quick)
+            } else if rail_mbs::vehicle::validate::CASES.contains(&name.as_str()) {
+                rail_mbs::vehicle::validate::run_case(&name, quick)
+            } else {
+                ancf_core::validate::run_case(&name, quick)
+            }
+        })?
+    };
     recs.into_iter()
         .map(|r| {
             let d = PyDict::new(py);
@@ -552,5 +568,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run_slosh, m)?)?;
     m.add_function(wrap_pyfunction!(run_validation, m)?)?;
     m.add_function(wrap_pyfunction!(_panic_for_test, m)?)?;
+    rail::register(m)?;
+    vehicle::register(m)?;
     Ok(())
 }

@@ -68,6 +68,8 @@
 pub mod contact;
 pub mod creep;
 pub mod hertz;
+pub mod static_load;
+pub mod validate;
 
 pub use contact::{
     ContactGeometry, ContactMethod, ContactPoint, ContactSettings, RailGeometry, RailPath, WheelGeometry, WheelPose,
@@ -77,6 +79,7 @@ pub use creep::{
     CreepForces, CreepModel, Creepages, KalkerCoefficients, creep_forces, kalker_coefficients, linear_coefficients,
 };
 pub use hertz::{HertzConstants, Material, combined_modulus, elliptic_ke};
+pub use static_load::{LoadedContact, VerticalTarget, WheelState, apply_creepages, solve_vertical};
 
 use thiserror::Error;
 

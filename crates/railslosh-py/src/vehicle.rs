@@ -1,0 +1,228 @@
+//! Bindings of the vehicle model: tank-car parameters (defaults with sources) and
+//! train runs with wheel loads, derailment indicators and coupler forces as arrays.
+
+use std::sync::Arc;
+
+use ancf_core::error::{AncfError, invalid};
+use numpy::{PyArray1, PyArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use rail_mbs::mbs::{SpeedProfile, Table};
+use rail_mbs::profile::aar1b_wheel_approx;
+use rail_mbs::track::{Track, TrackPoint};
+use rail_mbs::vehicle::{BrakeScope, TankCarParams, TrainRecord, TrainScenario, run_train as rust_run_train};
+
+use crate::compute;
+
+/// Scalar fields of [`TankCarParams`] a user can override, with getters and setters.
+type Field = (&'static str, fn(&TankCarParams) -> f64, fn(&mut TankCarParams, f64));
+
+const FIELDS: &[Field] = &[
+    ("tank_length", |p| p.tank_length, |p, v| p.tank_length = v),
+    ("tank_radius", |p| p.tank_radius, |p, v| p.tank_radius = v),
+    ("tank_axis_height", |p| p.tank_axis_height, |p, v| p.tank_axis_height = v),
+    ("tank_mass", |p| p.tank.mass, |p, v| p.tank.mass = v),
+    ("stub_sill_mass", |p| p.stub_sill.mass, |p, v| p.stub_sill.mass = v),
+    ("truck_centers", |p| p.truck_centers, |p, v| p.truck_centers = v),
+    ("wheelbase", |p| p.wheelbase, |p, v| p.wheelbase = v),
+    ("wheel_radius", |p| p.wheel_radius, |p, v| p.wheel_radius = v),
+    ("wheelset_mass", |p| p.wheelset.mass, |p, v| p.wheelset.mass = v),
+    ("bolster_mass", |p| p.bolster.mass, |p, v| p.bolster.mass = v),
+    ("frame_mass", |p| p.frame.mass, |p, v| p.frame.mass = v),
+    ("equalizer_mass", |p| p.equalizer.mass, |p, v| p.equalizer.mass = v),
+    ("journal_half_span", |p| p.journal_half_span, |p, v| p.journal_half_span = v),
+    ("secondary_half_span", |p| p.secondary_half_span, |p, v| p.secondary_half_span = v),
+    ("primary_kx", |p| p.primary.stiffness[0], |p, v| p.primary.stiffness[0] = v),
+    ("primary_ky", |p| p.primary.stiffness[1], |p, v| p.primary.stiffness[1] = v),
+    ("primary_kz", |p| p.primary.stiffness[2], |p, v| p.primary.stiffness[2] = v),
+    ("primary_cx", |p| p.primary.damping[0], |p, v| p.primary.damping[0] = v),
+    ("primary_cy", |p| p.primary.damping[1], |p, v| p.primary.damping[1] = v),
+    ("primary_cz", |p| p.primary.damping[2], |p, v| p.primary.damping[2] = v),
+    ("secondary_kx", |p| p.secondary.stiffness[0], |p, v| p.secondary.stiffness[0] = v),
+    ("secondary_ky", |p| p.secondary.stiffness[1], |p, v| p.secondary.stiffness[1] = v),
+    ("secondary_kz", |p| p.secondary.stiffness[2], |p, v| p.secondary.stiffness[2] = v),
+    ("secondary_cx", |p| p.secondary.damping[0], |p, v| p.secondary.damping[0] = v),
+    ("secondary_cy", |p| p.secondary.damping[1], |p, v| p.secondary.damping[1] = v),
+    ("secondary_cz", |p| p.secondary.damping[2], |p, v| p.secondary.damping[2] = v),
+    ("journal_k", |p| p.journal.stiffness[0], |p, v| p.journal.stiffness = [v; 3]),
+    ("journal_c", |p| p.journal.damping[0], |p, v| p.journal.damping = [v; 3]),
+    ("journal_tilt_stiffness", |p| p.journal_tilt_stiffness, |p, v| p.journal_tilt_stiffness = v),
+    ("coupler_height", |p| p.coupler_height, |p, v| p.coupler_height = v),
+    ("coupler_reach", |p| p.coupler_reach, |p, v| p.coupler_reach = v),
+    ("friction", |p| p.contact.friction, |p, v| p.contact.friction = v),
+    ("contact_damping", |p| p.contact.damping, |p, v| p.contact.damping = v),
+];
+
+fn car_params(overrides: Option<&Bound<'_, PyDict>>, wheel_profile: &str) -> PyResult<TankCarParams> {
+    let mut p = TankCarParams::standard().map_err(crate::to_py)?;
+    match wheel_profile {
+        "s1002" => {}
+        "aar1b" => {
+            p.contact.wheel_profile =
+                aar1b_wheel_approx().map_err(|e| crate::to_py(invalid("wheel_profile", e, "a valid profile")))?
+        }
+        other => return Err(crate::to_py(invalid("wheel_profile", other, "'s1002' or 'aar1b'"))),
+    }
+    if let Some(d) = overrides {
+        for (k, v) in d.iter() {
+            let key: String = k.extract()?;
+            let Some(f) = FIELDS.iter().find(|f| f.0 == key) else {
+                let names: Vec<&str> = FIELDS.iter().map(|f| f.0).collect();
+                return Err(crate::to_py(invalid("car", &key, &format!("one of {names:?}"))));
+            };
+            let x: f64 = v.extract().map_err(|_| crate::to_py(invalid(&format!("car.{key}"), v, "a number")))?;
+            (f.2)(&mut p, x);
+        }
+    }
+    p.validate().map_err(crate::to_py)?;
+    Ok(p)
+}
+
+/// Default tank-car parameters (the overridable scalar fields), the DOF count and the
+/// total mass; `car` overrides fields as in `run_train`.
+#[pyfunction]
+#[pyo3(signature = (car=None, wheel_profile="s1002"))]
+pub fn tank_car_parameters<'py>(
+    py: Python<'py>,
+    car: Option<&Bound<'py, PyDict>>,
+    wheel_profile: &str,
+) -> PyResult<Bound<'py, PyDict>> {
+    let p = car_params(car, wheel_profile)?;
+    let d = PyDict::new(py);
+    for f in FIELDS {
+        d.set_item(f.0, (f.1)(&p))?;
+    }
+    d.set_item("total_mass", p.total_mass())?;
+    let track = Arc::new(
+        Track::new(vec![
+            TrackPoint::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+            TrackPoint::new(100.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+        ])
+        .map_err(|e| crate::to_py(invalid("track", e, "valid")))?,
+    );
+    let sc = TrainScenario::single(p, track, 50.0, 0.0, 1.0);
+    let dof = compute(py, move || rail_mbs::vehicle::build_train(&sc).map(|(mb, _, _)| mb.dof()))?;
+    d.set_item("dof", dof)?;
+    Ok(d)
+}
+
+fn track_from_table(rows: Vec<Vec<f64>>) -> Result<Track, AncfError> {
+    let mut pts = Vec::with_capacity(rows.len());
+    for (i, r) in rows.iter().enumerate() {
+        if r.len() != 6 {
+            return Err(invalid(
+                &format!("track row {i}"),
+                format!("{r:?}"),
+                "6 numbers: s, curvature, superelevation, grade, cant_right, cant_left",
+            ));
+        }
+        pts.push(TrackPoint::new(r[0], r[1], r[2], r[3], r[4], r[5]));
+    }
+    Track::new(pts).map_err(|e| invalid("track", e, "a valid segment table"))
+}
+
+fn arr<'py>(py: Python<'py>, v: Vec<f64>, shape: &[usize]) -> PyResult<Bound<'py, PyAny>> {
+    Ok(PyArray1::from_vec(py, v).reshape(shape.to_vec())?.into_any())
+}
+
+fn record_dict<'py>(py: Python<'py>, r: &TrainRecord) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let nt = r.t.len();
+    let nw = r.wheel_vertical.first().map_or(0, |x| x.len());
+    let flat3 = |a: &Vec<Vec<[f64; 2]>>| a.iter().flat_map(|s| s.iter().flat_map(|w| w.iter().copied())).collect();
+    let flat2 = |a: &Vec<Vec<f64>>| a.iter().flat_map(|s| s.iter().copied()).collect::<Vec<f64>>();
+    d.set_item("t", PyArray1::from_vec(py, r.t.clone()))?;
+    d.set_item("wheel_vertical", arr(py, flat3(&r.wheel_vertical), &[nt, nw, 2])?)?;
+    d.set_item("wheel_lateral", arr(py, flat3(&r.wheel_lateral), &[nt, nw, 2])?)?;
+    d.set_item("l_over_v", arr(py, flat3(&r.l_over_v()), &[nt, nw, 2])?)?;
+    d.set_item("unloading", arr(py, flat3(&r.unloading()), &[nt, nw, 2])?)?;
+    d.set_item("wheelset_lateral", arr(py, flat2(&r.wheelset_lateral), &[nt, nw])?)?;
+    let nc = r.coupler_force.first().map_or(0, |x| x.len());
+    d.set_item("coupler_force", arr(py, flat2(&r.coupler_force), &[nt, nc])?)?;
+    let ncar = r.tank_station.first().map_or(0, |x| x.len());
+    d.set_item("tank_station", arr(py, flat2(&r.tank_station), &[nt, ncar])?)?;
+    d.set_item("tank_speed", arr(py, flat2(&r.tank_speed), &[nt, ncar])?)?;
+    d.set_item("static_wheel_load", r.static_wheel_load)?;
+    d.set_item("dof", r.dof)?;
+    let s = PyDict::new(py);
+    s.set_item("steps", r.steps)?;
+    s.set_item("rejected_steps", r.rejected_steps)?;
+    s.set_item("newton_iterations", r.newton_iterations)?;
+    s.set_item("jacobian_evaluations", r.jacobian_evaluations)?;
+    s.set_item("wall_time", r.wall_time)?;
+    d.set_item("stats", s)?;
+    Ok(d)
+}
+
+/// Runs a train of rigid-lading tank cars on a track given as rows
+/// `(s, curvature, superelevation, grade, cant_right, cant_left)` (SI). Returns a dict
+/// of arrays; on a failed run the dict has an `error` entry and the results so far.
+#[pyfunction]
+#[pyo3(signature = (
+    track, *, cars=1, station=50.0, speed=0.0, t_end=1.0, step=1e-3, record_every=0.01,
+    drive_speed=None, brake_times=None, brake_torques=None, brake_scope="all",
+    lading_mass=0.0, lading_height=0.0, wheel_profile="s1002", wheelset_lateral_offset=0.0,
+    coupler_stiffness=None, coupler_damping=None, car=None
+))]
+#[allow(clippy::too_many_arguments)]
+pub fn run_train<'py>(
+    py: Python<'py>,
+    track: Vec<Vec<f64>>,
+    cars: usize,
+    station: f64,
+    speed: f64,
+    t_end: f64,
+    step: f64,
+    record_every: f64,
+    drive_speed: Option<f64>,
+    brake_times: Option<Vec<f64>>,
+    brake_torques: Option<Vec<f64>>,
+    brake_scope: &str,
+    lading_mass: f64,
+    lading_height: f64,
+    wheel_profile: &str,
+    wheelset_lateral_offset: f64,
+    coupler_stiffness: Option<f64>,
+    coupler_damping: Option<f64>,
+    car: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let mut params = car_params(car, wheel_profile)?;
+    if lading_mass != 0.0 {
+        params.lading = Some((lading_mass, lading_height));
+    }
+    let scope = match brake_scope {
+        "all" => BrakeScope::AllCars,
+        "front" => BrakeScope::FrontCar,
+        other => return Err(crate::to_py(invalid("brake_scope", other, "'all' or 'front'"))),
+    };
+    let brake = match (brake_times, brake_torques) {
+        (Some(t), Some(m)) => Some((Table::new("brake_times/brake_torques", t, m).map_err(crate::to_py)?, scope)),
+        (None, None) => None,
+        _ => return Err(crate::to_py(invalid("brake_times/brake_torques", "one missing", "both or neither"))),
+    };
+    let track = Arc::new(track_from_table(track).map_err(crate::to_py)?);
+    let mut sc = TrainScenario::single(params, track, station, speed, t_end);
+    sc.cars = cars;
+    sc.step = step;
+    sc.record_every = record_every;
+    sc.drive = drive_speed.map(SpeedProfile::Constant);
+    sc.brake = brake;
+    sc.wheelset_lateral_offset = wheelset_lateral_offset;
+    sc.coupler = (coupler_stiffness, coupler_damping);
+    let out = compute(py, move || rust_run_train(&sc))?;
+    match out {
+        Ok(r) => record_dict(py, &r),
+        Err(f) => {
+            let d = record_dict(py, &f.record)?;
+            d.set_item("error", f.error.to_string())?;
+            Ok(d)
+        }
+    }
+}
+
+/// Registers the vehicle functions.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(tank_car_parameters, m)?)?;
+    m.add_function(wrap_pyfunction!(run_train, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,84 @@
+"""The tank-car / train model from Python (issue 4): parameters with defaults, runs returning
+wheel loads, derailment indicators and coupler forces as arrays, input errors, and the quick
+forms of the vehicle validation cases."""
+
+import numpy as np
+import pytest
+
+from railslosh import rail, validate, vehicle
+from railslosh.slosh import SimulationError
+
+TANGENT = [[0.0, 0.0, 0.0, 0.0, 0.0, 0.0], [3000.0, 0.0, 0.0, 0.0, 0.0, 0.0]]
+
+
+def test_parameters_have_defaults_dof_and_overrides():
+    p = vehicle.tank_car_parameters()
+    assert p["dof"] == 68
+    assert p["wheel_radius"] == pytest.approx(0.457)
+    assert p["tank_length"] == pytest.approx(12.0)
+    q = vehicle.tank_car_parameters({"wheelbase": 1.778, "tank_mass": 20000.0})
+    assert q["wheelbase"] == pytest.approx(1.778)
+    assert q["total_mass"] == pytest.approx(p["total_mass"] + 5000.0)
+
+
+def test_car_at_rest_carries_its_static_wheel_loads():
+    res = vehicle.run(TANGENT, t_end=0.2, record_every=0.05, lading_mass=36e3, lading_height=-0.5)
+    q = res["wheel_vertical"]
+    assert q.shape == (5, 4, 2)
+    np.testing.assert_allclose(q[-1], res["static_wheel_load"], rtol=1e-2)
+    # Total vertical load = weight of the car.
+    total = vehicle.tank_car_parameters()["total_mass"] + 36e3
+    assert q[-1].sum() == pytest.approx(total * 9.80665, rel=1e-3)
+    assert res["l_over_v"].shape == q.shape
+    np.testing.assert_allclose(res["unloading"][-1], 0.0, atol=1e-2)
+
+
+def test_braked_front_car_compresses_the_coupler_from_a_track_object():
+    track = rail.Track([0.0, 3000.0], curvature=[0.0, 0.0], superelevation=[0.0, 0.0])
+    res = vehicle.run(
+        track,
+        cars=2,
+        station=200.0,
+        speed=20 / 3.6,
+        t_end=0.5,
+        record_every=0.05,
+        brake=([0.0, 0.1], [0.0, 6000.0]),
+        brake_scope="front",
+    )
+    f = res["coupler_force"][:, 0]
+    assert (f[len(f) // 2 :] < 0).all(), f
+    assert res["wheel_vertical"].shape[1] == 8
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "field"),
+    [
+        ({"cars": 0}, "cars"),
+        ({"car": {"wheelbase": -1.0}}, "wheelbase"),
+        ({"car": {"no_such_field": 1.0}}, "car"),
+        ({"brake_scope": "middle"}, "brake_scope"),
+        ({"wheel_profile": "s1003"}, "wheel_profile"),
+        ({"t_end": -1.0}, "t_end"),
+        ({"brake": ([0.0, 1.0], [0.0])}, "brake"),
+    ],
+)
+def test_bad_input_names_the_field(kwargs, field):
+    with pytest.raises(ValueError, match=field):
+        vehicle.run(TANGENT, **kwargs)
+
+
+def test_bad_track_shape_is_rejected():
+    with pytest.raises(ValueError, match="track"):
+        vehicle.run([[0.0, 1.0]])
+
+
+def test_simulation_error_type_is_exported():
+    assert issubclass(SimulationError, Exception)
+
+
+@pytest.mark.parametrize("case", ["static-wheel-loads", "lateral-stability", "balance-speed-curving"])
+def test_quick_vehicle_case_passes(case):
+    records = validate.run([case], quick=True)
+    assert records
+    failed = [r for r in records if not r["passed"]]
+    assert not failed, failed
