@@ -155,6 +155,10 @@ pub struct PointJacobian {
     pub d_position: M3,
     /// ∂F/∂ṙ.
     pub d_velocity: M3,
+    /// The contact force F on the fluid at this point (N, global).
+    pub force: Vector3<f64>,
+    /// The point's position relative to the tank origin, r − R (m, global).
+    pub arm: Vector3<f64>,
 }
 
 /// Contact between one fluid body and one tank.
@@ -278,7 +282,7 @@ impl WallContact {
             if let Some(j) = jacobians.as_mut() {
                 let dv = a_mat * jv * at;
                 let dp = a_mat * jp * at - dv * wt;
-                j.push(PointJacobian { point: k, d_position: dp, d_velocity: dv });
+                j.push(PointJacobian { point: k, d_position: dp, d_velocity: dv, force: f, arm: d });
             }
         }
         load

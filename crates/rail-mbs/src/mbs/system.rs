@@ -160,6 +160,12 @@ impl Multibody {
         Ok(())
     }
 
+    /// Pattern index of the first entry of body `id`'s own 7×7 block (row-major), for
+    /// systems that embed this one with its pattern first.
+    pub fn body_block_index(&mut self, id: BodyId) -> usize {
+        self.layout().blocks[&(id.0, id.0)]
+    }
+
     /// Bodies.
     pub fn bodies(&self) -> &[RigidBody] {
         &self.bodies

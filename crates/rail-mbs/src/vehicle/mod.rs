@@ -33,10 +33,14 @@
 //! rate `V κ`, and — wheelsets — the rolling spin `V / r₀`. The front of the car (bogie
 //! 1, coupler end A) points towards increasing `s`.
 
+pub mod fluid;
 mod run;
 mod tank_car;
 pub mod validate;
 
+pub use fluid::{
+    FluidCargo, FluidTrainFailure, FluidTrainRecord, FluidVehicle, TankFluid, build_fluid_train, run_fluid_train,
+};
 pub use run::{BrakeScope, TrainFailure, TrainRecord, TrainScenario, build_train, run_train};
 pub use tank_car::{
     BodyMass, CarBodies, CarPlacement, ContactParams, SuspensionParams, TankCarParams, WheelLoad, add_coupler,

@@ -215,24 +215,25 @@ pub fn build_train(sc: &TrainScenario) -> Result<(Multibody, Vec<CarBodies>, Vec
     Ok((mb, cars, couplers))
 }
 
-fn record_sample(
-    hht: &mut Hht<Multibody>,
+/// Records one sample of the rigid vehicle state (wheel loads, couplers, tanks) of a
+/// multibody system at `(t, q, v)` (rigid coordinates only).
+pub(crate) fn record_sample(
+    mb: &mut Multibody,
+    (t, q, v): (f64, &[f64], &[f64]),
     track: &Track,
     cars: &[CarBodies],
     couplers: &[usize],
     hints: &mut [f64],
     rec: &mut TrainRecord,
 ) -> Result<(), IntegratorError> {
-    let (q, v) = (hht.q().to_vec(), hht.v().to_vec());
-    let t = hht.t();
-    let reps = hht.system_mut().wheelset_reports(&q, &v).map_err(|e| IntegratorError::System { t, source: e })?;
-    let mb = hht.system();
+    let reps = mb.wheelset_reports(q, v).map_err(|e| IntegratorError::System { t, source: e })?;
+    let mb = &*mb;
     let mut qv = Vec::new();
     let mut yv = Vec::new();
     let mut lat = Vec::new();
     for car in cars {
         for (w, ws) in car.wheelsets.iter().enumerate() {
-            let s = mb.state(Some(*ws), &q, &v);
+            let s = mb.state(Some(*ws), q, v);
             let k = car.contacts[w];
             let proj = track.project(&s.position, Some(hints[k])).ok();
             let (up, left, y) = match proj {
@@ -249,7 +250,7 @@ fn record_sample(
             lat.push(y);
         }
     }
-    let forces = mb.force_outputs(t, &q, &v);
+    let forces = mb.force_outputs(t, q, v);
     rec.t.push(t);
     rec.wheel_vertical.push(qv);
     rec.wheel_lateral.push(yv);
@@ -258,7 +259,7 @@ fn record_sample(
     let mut st = Vec::new();
     let mut sp = Vec::new();
     for car in cars {
-        let s = mb.state(Some(car.tank), &q, &v);
+        let s = mb.state(Some(car.tank), q, v);
         st.push(track.project(&s.position, Some(car.station)).map_or(f64::NAN, |p| p.s));
         sp.push(s.velocity.norm());
     }
@@ -298,7 +299,10 @@ pub fn run_train(sc: &TrainScenario) -> Result<Result<TrainRecord, Box<TrainFail
                 return Ok(Err(Box::new(TrainFailure { error, record: finish(Some(&hht), rec) })));
             }
         }
-        if let Err(error) = record_sample(&mut hht, &sc.track, &cars, &couplers, &mut hints, &mut rec) {
+        let (t, q, v) = (hht.t(), hht.q().to_vec(), hht.v().to_vec());
+        if let Err(error) =
+            record_sample(hht.system_mut(), (t, &q, &v), &sc.track, &cars, &couplers, &mut hints, &mut rec)
+        {
             return Ok(Err(Box::new(TrainFailure { error, record: finish(Some(&hht), rec) })));
         }
     }

@@ -97,6 +97,9 @@ pub struct TankCarParams {
     /// Rigid lading added to the tank body (kg, centre height above the tank axis, m).
     /// Default none (the fluid is modelled separately).
     pub lading: Option<(f64, f64)>,
+    /// Mass carried in the tank but modelled as separate bodies (the ANCF fluid), kg: it
+    /// counts in the suspension preloads and the static wheel loads. Default 0.
+    pub carried_mass: f64,
     /// Each stub sill. Default 1200 kg (assumed).
     pub stub_sill: BodyMass,
     /// Distance between the bogie (truck) centres, m. Default 9.0 (assumed for a 12 m
@@ -159,6 +162,7 @@ impl TankCarParams {
             tank_axis_height: 2.35,
             tank: shell,
             lading: None,
+            carried_mass: 0.0,
             stub_sill: BodyMass { mass: 1200.0, inertia: [60.0, 250.0, 250.0] },
             truck_centers: 9.0,
             wheelbase: 1.829,
@@ -183,6 +187,7 @@ impl TankCarParams {
     pub fn total_mass(&self) -> f64 {
         self.tank.mass
             + self.lading.map_or(0.0, |l| l.0)
+            + self.carried_mass
             + 2.0 * self.stub_sill.mass
             + 2.0 * (self.bolster.mass + self.frame.mass + 2.0 * self.equalizer.mass + 2.0 * self.wheelset.mass)
     }
@@ -225,6 +230,9 @@ impl TankCarParams {
             for (k, i) in b.inertia.iter().enumerate() {
                 check_positive(&format!("{name}.inertia[{k}]"), *i)?;
             }
+        }
+        if !(self.carried_mass.is_finite() && self.carried_mass >= 0.0) {
+            return Err(invalid("carried_mass", self.carried_mass, "finite, >= 0 kg"));
         }
         if let Some((m, _)) = self.lading
             && !(m.is_finite() && m >= 0.0)
@@ -465,7 +473,7 @@ pub fn add_tank_car(
     let mut wheelsets = [tank; 4];
     let mut contacts = [0; 4];
     // Static loads on level track.
-    let body_weight = (tank_mass.mass + 2.0 * p.stub_sill.mass) * g;
+    let body_weight = (tank_mass.mass + p.carried_mass + 2.0 * p.stub_sill.mass) * g;
     let per_bogie = 0.5 * body_weight;
     let per_axlebox = 0.25 * (per_bogie + (p.bolster.mass + p.frame.mass) * g);
     let per_bearing = 0.5 * p.equalizer.mass * g;

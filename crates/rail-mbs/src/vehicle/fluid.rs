@@ -1,0 +1,587 @@
+//! ANCF fluid bodies inside the tanks of a multibody vehicle, solved in one implicit
+//! (monolithic) system with the rigid bodies ([`FluidVehicle`]).
+//!
+//! Coordinates: the rigid bodies of the [`Multibody`] first (`7` per body), then the
+//! nodal coordinates of each fluid body (global frame). Each fluid touches its tank body
+//! only through the penalty wall/bulkhead contact of seed 000 §5: the contact forces act
+//! on the fluid, and the equal and opposite load (force, and moment about the tank body
+//! origin) acts on the tank body (`Q_CB^t`). The tank frame of the fluid mesh and
+//! contact geometry is the tank body frame (origin at the tank body's centre of mass,
+//! which must be the tank's geometric centre; no rigid lading on fluid-carrying tanks).
+//!
+//! # Jacobians
+//!
+//! * fluid–fluid: exact element Jacobians and contact point Jacobians (as in
+//!   [`crate::slosh::SloshSystem`]);
+//! * tank rows × fluid columns: exact, from the point Jacobians, forces and arms:
+//!   `∂Q_R/∂r_k = −K_k`, `∂M/∂r_k = F̃_k − d̃_k K_k`, `∂M/∂ṙ_k = −d̃_k C_k`, mapped to the
+//!   Euler parameters by `2 Eᵀ`;
+//! * fluid rows and the tank block × tank columns: forward finite differences over the
+//!   tank's 14 coordinates and velocities (one contact pass each).
+//!
+//! The coupling blocks are what keeps Newton convergent when the tank is light compared
+//! with its fluid (the added-mass instability of explicit coupling, seed 003).
+
+use std::collections::HashMap;
+
+use ancf_core::FluidBody;
+use ancf_core::contact::{PointJacobian, TankKinematics, WallContact};
+use ancf_core::error::AncfError;
+use ancf_core::shape::N_SHAPE;
+use nalgebra::{Matrix3, Vector3};
+
+use crate::integrator::{MechanicalSystem, SparsityPattern, SystemError};
+use crate::mbs::{BodyId, BodyState, Multibody};
+
+/// Finite-difference steps for the tank coordinates and velocities.
+const FD_Q: f64 = 1e-7;
+const FD_V: f64 = 1e-6;
+
+/// One fluid body in one tank.
+#[derive(Debug, Clone)]
+pub struct TankFluid {
+    /// The tank (car body) it is in.
+    pub tank: BodyId,
+    /// The fluid.
+    pub body: FluidBody,
+    /// Wall and bulkhead contact with the tank.
+    pub contact: WallContact,
+}
+
+#[derive(Debug, Clone, Default)]
+struct FluidLayout {
+    /// First global coordinate of the fluid.
+    offset: usize,
+    /// Pattern index of each node-pair 12×12 block.
+    blocks: HashMap<(usize, usize), usize>,
+    /// Per element: the 64 node-pair block starts.
+    element_blocks: Vec<[usize; 64]>,
+    /// Pattern start of the 7 × n_f tank-rows block (row-major) and of the n_f × 7
+    /// fluid-rows block (row-major).
+    tank_rows: usize,
+    fluid_rows: usize,
+}
+
+/// Rigid multibody vehicle plus fluids in its tanks.
+#[derive(Debug)]
+pub struct FluidVehicle {
+    /// The rigid multibody system.
+    pub mb: Multibody,
+    /// The fluids.
+    pub fluids: Vec<TankFluid>,
+    layouts: Vec<FluidLayout>,
+    mb_entries: usize,
+    n_rigid: usize,
+    point_jac: Vec<PointJacobian>,
+}
+
+fn sys_err(e: AncfError) -> SystemError {
+    match e {
+        AncfError::InvertedElement { element, point, j } => SystemError::Element {
+            index: element,
+            reason: format!("fluid element inverted: J = {j:.3e} at point {point}"),
+        },
+        AncfError::NonFinite { element, what } => SystemError::Element { index: element, reason: what },
+        other => SystemError::Other(other.to_string()),
+    }
+}
+
+/// Tank kinematics for the contact from a body state.
+pub fn tank_kinematics(s: &BodyState) -> TankKinematics {
+    TankKinematics {
+        position: s.position.into(),
+        rotation: s.rotation,
+        velocity: s.velocity.into(),
+        angular_velocity: s.angular_velocity.into(),
+    }
+}
+
+impl FluidVehicle {
+    /// Assembles the coupled system and its fixed sparsity pattern.
+    pub fn new(mb: Multibody, fluids: Vec<TankFluid>) -> Result<Self, AncfError> {
+        let n_rigid = mb.n_coords();
+        for f in &fluids {
+            if f.tank.0 >= mb.bodies().len() {
+                return Err(ancf_core::error::invalid("fluid tank body", f.tank.0, "an existing body"));
+            }
+        }
+        let mb_entries = mb.pattern().dynamics.len();
+        let mut s = Self { mb, fluids, layouts: Vec::new(), mb_entries, n_rigid, point_jac: Vec::new() };
+        let (_, layouts) = s.build_pattern();
+        s.layouts = layouts;
+        Ok(s)
+    }
+
+    fn build_pattern(&self) -> (SparsityPattern, Vec<FluidLayout>) {
+        let mut pat = self.mb.pattern();
+        let mut layouts = Vec::new();
+        let mut offset = self.n_rigid;
+        for f in &self.fluids {
+            let mut lay = FluidLayout { offset, ..Default::default() };
+            for nodes in &f.body.mesh.elements {
+                let mut eb = [0usize; 64];
+                for (i, &ni) in nodes.iter().enumerate() {
+                    for (j, &nj) in nodes.iter().enumerate() {
+                        let start = *lay.blocks.entry((ni, nj)).or_insert_with(|| {
+                            let s = pat.dynamics.len();
+                            for r in 0..12 {
+                                for c in 0..12 {
+                                    pat.dynamics.push((offset + 12 * ni + r, offset + 12 * nj + c));
+                                }
+                            }
+                            s
+                        });
+                        eb[8 * i + j] = start;
+                    }
+                }
+                lay.element_blocks.push(eb);
+            }
+            let nf = f.body.n_coords();
+            let t0 = 7 * f.tank.0;
+            lay.tank_rows = pat.dynamics.len();
+            for r in 0..7 {
+                for c in 0..nf {
+                    pat.dynamics.push((t0 + r, offset + c));
+                }
+            }
+            lay.fluid_rows = pat.dynamics.len();
+            for r in 0..nf {
+                for c in 0..7 {
+                    pat.dynamics.push((offset + r, t0 + c));
+                }
+            }
+            offset += nf;
+            layouts.push(lay);
+        }
+        (pat, layouts)
+    }
+
+    /// Initial coordinates: the rigid bodies' and each fluid's reference mesh (tank frame)
+    /// placed at its tank's initial pose, moving rigidly with it.
+    pub fn initial_coordinates(&self) -> (Vec<f64>, Vec<f64>) {
+        let (mut q, mut v) = self.mb.initial_coordinates();
+        for f in &self.fluids {
+            let s = self.mb.initial_state(Some(f.tank));
+            let e0 = f.body.reference_coordinates();
+            for (k, x) in e0.chunks_exact(3).enumerate() {
+                let y = s.rotation * Vector3::new(x[0], x[1], x[2]);
+                let (p, vel) = if k % 4 == 0 {
+                    (y + s.position, s.angular_velocity.cross(&y) + s.velocity)
+                } else {
+                    (y, s.angular_velocity.cross(&y))
+                };
+                q.extend_from_slice(p.as_slice());
+                v.extend_from_slice(vel.as_slice());
+            }
+        }
+        (q, v)
+    }
+
+    /// Coordinates of fluid `k` within a global vector.
+    pub fn fluid_slice<'a>(&self, k: usize, x: &'a [f64]) -> &'a [f64] {
+        let o = self.layouts[k].offset;
+        &x[o..o + self.fluids[k].body.n_coords()]
+    }
+
+    /// Fluid contact load on its tank (force, moment about the tank origin; global) at a state.
+    pub fn fluid_load(&self, k: usize, q: &[f64], v: &[f64]) -> ancf_core::contact::ContactLoad {
+        let f = &self.fluids[k];
+        let s = self.mb.state(Some(f.tank), &q[..self.n_rigid], &v[..self.n_rigid]);
+        let mut scratch = vec![0.0; f.body.n_coords()];
+        f.contact.forces(
+            &f.body,
+            &tank_kinematics(&s),
+            self.fluid_slice(k, q),
+            self.fluid_slice(k, v),
+            &mut scratch,
+            None,
+        )
+    }
+
+    /// Contact forces on fluid `k` (into `out`, its slice) and the generalized load on its tank.
+    fn contact_pass(&self, k: usize, tank: &BodyState, e: &[f64], ed: &[f64], out: &mut [f64]) -> [f64; 7] {
+        let f = &self.fluids[k];
+        let load = f.contact.forces(&f.body, &tank_kinematics(tank), e, ed, out, None);
+        tank.generalized(&Vector3::from(load.force), &Vector3::from(load.moment))
+    }
+}
+
+impl MechanicalSystem for FluidVehicle {
+    fn n_coords(&self) -> usize {
+        self.n_rigid + self.fluids.iter().map(|f| f.body.n_coords()).sum::<usize>()
+    }
+
+    fn n_constraints(&self) -> usize {
+        self.mb.n_constraints()
+    }
+
+    fn pattern(&self) -> SparsityPattern {
+        self.build_pattern().0
+    }
+
+    fn mass(&mut self, q: &[f64], values: &mut [f64]) -> Result<(), SystemError> {
+        let nr = self.n_rigid;
+        self.mb.mass(&q[..nr], &mut values[..self.mb_entries])?;
+        for (f, lay) in self.fluids.iter().zip(&self.layouts) {
+            let m = f.body.scalar_mass().as_ref();
+            for j in 0..m.ncols() {
+                for (i, val) in m.row_idx_of_col(j).zip(m.val_of_col(j)) {
+                    for k in 0..3 {
+                        let (r, c) = (3 * i + k, 3 * j + k);
+                        values[lay.blocks[&(r / 12, c / 12)] + (r % 12) * 12 + c % 12] += val;
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn forces(&mut self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) -> Result<(), SystemError> {
+        let nr = self.n_rigid;
+        out.fill(0.0);
+        MechanicalSystem::forces(&mut self.mb, t, &q[..nr], &v[..nr], &mut out[..nr])?;
+        let g = self.mb.gravity;
+        for k in 0..self.fluids.len() {
+            let lay = &self.layouts[k];
+            let f = &self.fluids[k];
+            let n = f.body.n_coords();
+            let (e, ed) = (&q[lay.offset..lay.offset + n], &v[lay.offset..lay.offset + n]);
+            let of = &mut out[lay.offset..lay.offset + n];
+            f.body.internal_forces(e, ed, of).map_err(sys_err)?;
+            of.iter_mut().for_each(|x| *x = -*x);
+            for (s, o) in f.body.gravity_scale().iter().zip(of.chunks_exact_mut(3)) {
+                for i in 0..3 {
+                    o[i] += s * g[i];
+                }
+            }
+            let tank = self.mb.state(Some(f.tank), &q[..nr], &v[..nr]);
+            let load_gen = self.contact_pass(k, &tank, e, ed, of);
+            let o = 7 * f.tank.0;
+            for i in 0..7 {
+                out[o + i] += load_gen[i];
+            }
+        }
+        if let Some(i) = out.iter().position(|x| !x.is_finite()) {
+            return Err(SystemError::Other(format!("non-finite generalized force at coordinate {i}")));
+        }
+        Ok(())
+    }
+
+    fn force_jacobians(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        dq: &mut [f64],
+        dv: &mut [f64],
+    ) -> Result<(), SystemError> {
+        let nr = self.n_rigid;
+        let me = self.mb_entries;
+        self.mb.force_jacobians(t, &q[..nr], &v[..nr], &mut dq[..me], &mut dv[..me])?;
+        let mut pj = std::mem::take(&mut self.point_jac);
+        for k in 0..self.fluids.len() {
+            let lay = &self.layouts[k];
+            let f = &self.fluids[k];
+            let n = f.body.n_coords();
+            let (e, ed) = (&q[lay.offset..lay.offset + n], &v[lay.offset..lay.offset + n]);
+            let idx = |eb: &[usize; 64], a: usize, i: usize, b: usize, c: usize| {
+                eb[8 * (a / 4) + b / 4] + (3 * (a % 4) + i) * 12 + 3 * (b % 4) + c
+            };
+            // Fluid–fluid: element Jacobians.
+            let jacs = f.body.element_jacobians(e, ed).map_err(sys_err)?;
+            for (el, jac) in jacs.iter().enumerate() {
+                let eb = &lay.element_blocks[el];
+                for a in 0..N_SHAPE {
+                    for b in 0..N_SHAPE {
+                        for i in 0..3 {
+                            let row = 96 * (3 * a + i);
+                            for c in 0..3 {
+                                let x = idx(eb, a, i, b, c);
+                                dq[x] -= jac.stiffness[row + 3 * b + c];
+                                dv[x] -= jac.damping[row + 3 * b + c];
+                            }
+                        }
+                    }
+                }
+            }
+            // Contact: fluid–fluid point Jacobians and the exact tank rows.
+            let tank = self.mb.state(Some(f.tank), &q[..nr], &v[..nr]);
+            let mut scratch = vec![0.0; n];
+            f.contact.forces(&f.body, &tank_kinematics(&tank), e, ed, &mut scratch, Some(&mut pj));
+            let et2 = crate::mbs::rotation::e_matrix(&tank.params).transpose() * 2.0;
+            for p in &pj {
+                let pt = &f.contact.points[p.point];
+                let eb = &lay.element_blocks[pt.element];
+                let nodes = &f.body.mesh.elements[pt.element];
+                let dm_dr: Matrix3<f64> = p.force.cross_matrix() - p.arm.cross_matrix() * p.d_position;
+                let dm_dv: Matrix3<f64> = -(p.arm.cross_matrix() * p.d_velocity);
+                let gp_dr = et2 * dm_dr;
+                let gp_dv = et2 * dm_dv;
+                for a in 0..N_SHAPE {
+                    let na = pt.shape[a];
+                    if na == 0.0 {
+                        continue;
+                    }
+                    for b in 0..N_SHAPE {
+                        let nn = na * pt.shape[b];
+                        for i in 0..3 {
+                            for c in 0..3 {
+                                let x = idx(eb, a, i, b, c);
+                                dq[x] += nn * p.d_position[(i, c)];
+                                dv[x] += nn * p.d_velocity[(i, c)];
+                            }
+                        }
+                    }
+                    // Tank rows × fluid column (3 × node(a) + comp).
+                    let col = 3 * (4 * nodes[a / 4] + a % 4);
+                    for c in 0..3 {
+                        for r in 0..3 {
+                            let x = lay.tank_rows + r * n + col + c;
+                            dq[x] -= na * p.d_position[(r, c)];
+                            dv[x] -= na * p.d_velocity[(r, c)];
+                        }
+                        for r in 0..4 {
+                            let x = lay.tank_rows + (3 + r) * n + col + c;
+                            dq[x] += na * gp_dr[(r, c)];
+                            dv[x] += na * gp_dv[(r, c)];
+                        }
+                    }
+                }
+            }
+            // Tank columns: forward differences of the contact pass.
+            let t0 = 7 * f.tank.0;
+            let mut base = vec![0.0; n];
+            let gen0 = self.contact_pass(k, &tank, e, ed, &mut base);
+            let mut qt = [0.0; 7];
+            let mut vt = [0.0; 7];
+            qt.copy_from_slice(&q[t0..t0 + 7]);
+            vt.copy_from_slice(&v[t0..t0 + 7]);
+            let mut tank_block_q = [[0.0; 7]; 7];
+            let mut tank_block_v = [[0.0; 7]; 7];
+            for c in 0..14 {
+                let (mut qp, mut vp) = (qt, vt);
+                let h = if c < 7 { FD_Q } else { FD_V };
+                if c < 7 {
+                    qp[c] += h;
+                } else {
+                    vp[c - 7] += h;
+                }
+                let st = BodyState::from_coordinates(&qp, &vp);
+                let mut fp = vec![0.0; n];
+                let load_gen = self.contact_pass(k, &st, e, ed, &mut fp);
+                let (target, col) = if c < 7 { (&mut *dq, c) } else { (&mut *dv, c - 7) };
+                for r in 0..n {
+                    let d = (fp[r] - base[r]) / h;
+                    if d != 0.0 {
+                        target[lay.fluid_rows + r * 7 + col] += d;
+                    }
+                }
+                let blk = if c < 7 { &mut tank_block_q } else { &mut tank_block_v };
+                for r in 0..7 {
+                    blk[r][col] = (load_gen[r] - gen0[r]) / h;
+                }
+            }
+            // Tank–tank block lives in the multibody part (the body's own 7×7 block).
+            let diag = self.mb.body_block_index(f.tank);
+            for r in 0..7 {
+                for c in 0..7 {
+                    dq[diag + 7 * r + c] += tank_block_q[r][c];
+                    dv[diag + 7 * r + c] += tank_block_v[r][c];
+                }
+            }
+        }
+        self.point_jac = pj;
+        Ok(())
+    }
+
+    fn constraints(&mut self, t: f64, q: &[f64], out: &mut [f64]) -> Result<(), SystemError> {
+        self.mb.constraints(t, &q[..self.n_rigid], out)
+    }
+
+    fn constraint_jacobian(&mut self, t: f64, q: &[f64], values: &mut [f64]) -> Result<(), SystemError> {
+        self.mb.constraint_jacobian(t, &q[..self.n_rigid], values)
+    }
+
+    fn constraint_force_jacobian(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        lambda: &[f64],
+        dq: &mut [f64],
+    ) -> Result<bool, SystemError> {
+        let me = self.mb_entries;
+        self.mb.constraint_force_jacobian(t, &q[..self.n_rigid], lambda, &mut dq[..me])
+    }
+}
+
+use ancf_core::constitutive::Fluid;
+use ancf_core::contact::WallContactLaw;
+use ancf_core::element::QuadratureOptions;
+use ancf_core::mesh::{CylinderTankSpec, cylinder_tank, cylinder_tank_compartments};
+use ancf_core::tank::{Bulkhead, TankGeometry, TankShape};
+use std::time::Instant;
+
+use super::run::{TrainRecord, TrainScenario, build_train, record_sample};
+use super::tank_car::CarBodies;
+use crate::integrator::{Hht, IntegratorError};
+
+/// Liquid cargo of every car of a train: an ANCF fluid mesh of the car's tank
+/// (cylinder with half-ellipsoid heads 0.5 m deep, overall length `tank_length`).
+#[derive(Debug, Clone)]
+pub struct FluidCargo {
+    /// The fluid, with its penalty parameters.
+    pub fluid: Fluid,
+    /// Elements along the length, across the width and over the height.
+    pub counts: [usize; 3],
+    /// Fill fraction of the tank height (0, 1).
+    pub fill: f64,
+    /// Bulkheads `(x, thickness)` in the tank frame, m.
+    pub bulkheads: Vec<(f64, f64)>,
+    /// Quadrature of the fluid elements.
+    pub quadrature: QuadratureOptions,
+}
+
+/// Results of a train run with fluid cargo.
+#[derive(Debug, Clone, Default)]
+pub struct FluidTrainRecord {
+    /// The vehicle results (wheel loads, couplers, tanks).
+    pub train: TrainRecord,
+    /// Fluid centre of mass in the tank frame, m: `[sample][car]`.
+    pub oil_com_tank: Vec<Vec<[f64; 3]>>,
+    /// Fluid load on the tank (contact force), tank frame, N: `[sample][car]`.
+    pub fluid_force_tank: Vec<Vec<[f64; 3]>>,
+    /// Relative fluid volume change: `[sample][car]`.
+    pub volume_error: Vec<Vec<f64>>,
+    /// Fluid mass per car, kg.
+    pub fluid_mass: f64,
+    /// Fluid elements per car.
+    pub elements: usize,
+}
+
+/// A fluid run that stopped early: why, and what was recorded.
+#[derive(Debug)]
+pub struct FluidTrainFailure {
+    /// The error.
+    pub error: IntegratorError,
+    /// Results up to the failure.
+    pub record: FluidTrainRecord,
+}
+
+/// Builds a train whose tanks carry `cargo` as ANCF fluid bodies.
+pub fn build_fluid_train(
+    sc: &TrainScenario,
+    cargo: &FluidCargo,
+) -> Result<(FluidVehicle, Vec<CarBodies>, Vec<usize>), AncfError> {
+    let p = &sc.car;
+    let head = 0.5;
+    let spec = CylinderTankSpec {
+        length: p.tank_length - 2.0 * head,
+        radius: p.tank_radius,
+        head_depth: head,
+        fill: cargo.fill,
+        n_length: cargo.counts[0],
+        n_width: cargo.counts[1],
+        n_height: cargo.counts[2],
+        grading: 1.0,
+    };
+    let mesh = if cargo.bulkheads.is_empty() {
+        cylinder_tank(&spec)?
+    } else {
+        cylinder_tank_compartments(&spec, &cargo.bulkheads)?
+    };
+    let body = FluidBody::new(mesh, cargo.fluid, cargo.quadrature)?;
+    let geometry = TankGeometry::new(
+        TankShape::Cylinder { length: spec.length, radius: spec.radius, head_depth: head },
+        cargo.bulkheads.iter().map(|&(x, thickness)| Bulkhead { x, thickness }).collect(),
+    )?;
+    let g = crate::track::GRAVITY;
+    let depth = 2.0 * p.tank_radius * cargo.fill;
+    let law = WallContactLaw::default_for(cargo.fluid.density, g, depth);
+    let contact = WallContact::new(&body, geometry, law)?;
+    let mut sc2 = sc.clone();
+    sc2.car.carried_mass = body.total_mass();
+    sc2.car.lading = None;
+    let (mb, cars, couplers) = build_train(&sc2)?;
+    let fluids =
+        cars.iter().map(|c| TankFluid { tank: c.tank, body: body.clone(), contact: contact.clone() }).collect();
+    Ok((FluidVehicle::new(mb, fluids)?, cars, couplers))
+}
+
+fn record_fluid(sys: &FluidVehicle, q: &[f64], v: &[f64], rec: &mut FluidTrainRecord) {
+    let nr = sys.mb.n_coords();
+    let mut com = Vec::new();
+    let mut load = Vec::new();
+    let mut vol = Vec::new();
+    for (k, f) in sys.fluids.iter().enumerate() {
+        let s = sys.mb.state(Some(f.tank), &q[..nr], &v[..nr]);
+        let e = sys.fluid_slice(k, q);
+        let c = Vector3::from(f.body.center_of_mass(e));
+        com.push(<[f64; 3]>::from(s.rotation.transpose() * (c - s.position)));
+        let l = sys.fluid_load(k, q, v);
+        load.push(<[f64; 3]>::from(s.rotation.transpose() * Vector3::from(l.force)));
+        vol.push(f.body.volume(e) / f.body.reference_volume() - 1.0);
+    }
+    rec.oil_com_tank.push(com);
+    rec.fluid_force_tank.push(load);
+    rec.volume_error.push(vol);
+}
+
+/// Runs a train with fluid cargo; on failure returns what was recorded with the error.
+pub fn run_fluid_train(
+    sc: &TrainScenario,
+    cargo: &FluidCargo,
+) -> Result<Result<FluidTrainRecord, Box<FluidTrainFailure>>, AncfError> {
+    let (sys, cars, couplers) = build_fluid_train(sc, cargo)?;
+    let mut rec = FluidTrainRecord {
+        fluid_mass: sys.fluids[0].body.total_mass(),
+        elements: sys.fluids[0].body.mesh.n_elements(),
+        ..Default::default()
+    };
+    rec.train.static_wheel_load = cars[0].static_wheel_load;
+    rec.train.dof = sys.mb.dof() + sys.fluids.iter().map(|f| f.body.n_coords() as isize).sum::<isize>();
+    let nr = sys.mb.n_coords();
+    let (q0, v0) = sys.initial_coordinates();
+    let start = Instant::now();
+    let finish = |hht: Option<&Hht<FluidVehicle>>, mut rec: FluidTrainRecord| {
+        if let Some(h) = hht {
+            let s = h.stats();
+            rec.train.newton_iterations = s.newton_iterations;
+            rec.train.steps = s.steps;
+            rec.train.rejected_steps = s.rejected_steps;
+            rec.train.jacobian_evaluations = s.jacobian_evaluations;
+        }
+        rec.train.wall_time = start.elapsed().as_secs_f64();
+        rec
+    };
+    let mut hht = match Hht::new(sys, 0.0, q0, v0, sc.hht) {
+        Ok(h) => h,
+        Err(error) => return Ok(Err(Box::new(FluidTrainFailure { error, record: finish(None, rec) }))),
+    };
+    let mut hints: Vec<f64> = cars.iter().flat_map(|c| [c.station; 4]).collect();
+    let n_rec = (sc.t_end / sc.record_every).round() as usize;
+    for k in 0..=n_rec {
+        let target = (k as f64 * sc.record_every).min(sc.t_end);
+        while hht.t() < target - 1e-12 {
+            let h = sc.step.min(target - hht.t());
+            if let Err(error) = hht.step(h) {
+                return Ok(Err(Box::new(FluidTrainFailure { error, record: finish(Some(&hht), rec) })));
+            }
+        }
+        let (t, q, v) = (hht.t(), hht.q().to_vec(), hht.v().to_vec());
+        let sys = hht.system_mut();
+        let res = record_sample(
+            &mut sys.mb,
+            (t, &q[..nr], &v[..nr]),
+            &sc.track,
+            &cars,
+            &couplers,
+            &mut hints,
+            &mut rec.train,
+        );
+        if let Err(error) = res {
+            return Ok(Err(Box::new(FluidTrainFailure { error, record: finish(Some(&hht), rec) })));
+        }
+        record_fluid(hht.system(), &q, &v, &mut rec);
+    }
+    Ok(Ok(finish(Some(&hht), rec)))
+}

@@ -1,0 +1,151 @@
+//! The monolithic fluid–vehicle system: its assembled Jacobians (including the
+//! fluid↔tank coupling blocks) match finite differences of its forces, and a fluid at
+//! rest in a free tank body hanging on springs puts its whole weight on the tank.
+
+use ancf_core::FluidBody;
+use ancf_core::constitutive::{Fluid, Rheology};
+use ancf_core::contact::{WallContact, WallContactLaw};
+use ancf_core::element::QuadratureOptions;
+use ancf_core::mesh::{CylinderTankSpec, cylinder_tank};
+use ancf_core::tank::{TankGeometry, TankShape};
+use nalgebra::{Matrix3, Vector3};
+use rail_mbs::integrator::{Hht, MechanicalSystem};
+use rail_mbs::mbs::rotation::axis_angle;
+use rail_mbs::mbs::{BodyId, Bushing, Multibody, RigidBody};
+use rail_mbs::vehicle::{FluidVehicle, TankFluid};
+
+fn system(with_springs: bool) -> FluidVehicle {
+    let spec = CylinderTankSpec {
+        length: 3.0,
+        radius: 1.0,
+        head_depth: 0.3,
+        fill: 0.5,
+        n_length: 2,
+        n_width: 2,
+        n_height: 2,
+        grading: 1.0,
+    };
+    let mesh = cylinder_tank(&spec).unwrap();
+    let k = 1000.0 * 850.0 * 9.81 * 1.0;
+    let mut fluid = Fluid::new(850.0, Rheology::Newtonian { viscosity: 0.05 }, k).unwrap();
+    fluid.bulk_damping = 0.2 * (k * 850.0f64).sqrt() * 0.5;
+    let body = FluidBody::new(mesh, fluid, QuadratureOptions::default()).unwrap();
+    let geo = TankGeometry::new(TankShape::Cylinder { length: 3.0, radius: 1.0, head_depth: 0.3 }, vec![]).unwrap();
+    let contact = WallContact::new(&body, geo, WallContactLaw::default_for(850.0, 9.81, 1.0)).unwrap();
+    let mut mb = Multibody::new();
+    let mut tank = RigidBody::new("tank", 2000.0, [800.0, 2000.0, 2000.0], Vector3::new(1.0, 0.5, 2.0));
+    if !with_springs {
+        tank.orientation = axis_angle(&Vector3::new(0.2, 1.0, 0.4), 0.05);
+        tank.velocity = Vector3::new(0.3, -0.1, 0.05);
+        tank.angular_velocity = Vector3::new(0.05, 0.1, -0.08);
+    }
+    let id = mb.add_body(tank).unwrap();
+    if with_springs {
+        for x in [-1.0, 1.0] {
+            for y in [-0.5, 0.5] {
+                mb.add_force(Box::new(Bushing {
+                    name: format!("spring {x} {y}"),
+                    bodies: [None, Some(id)],
+                    points: [Vector3::new(1.0 + x, 0.5 + y, 0.0), Vector3::new(x, y, -2.0)],
+                    frame_i: Matrix3::identity(),
+                    frame_j: Matrix3::identity(),
+                    offset: Vector3::zeros(),
+                    stiffness: [1e7; 3],
+                    damping: [1e5; 3],
+                    preload: Vector3::zeros(),
+                    rotational_stiffness: [0.0; 3],
+                    rotational_damping: [0.0; 3],
+                    free_axis: None,
+                }))
+                .unwrap();
+            }
+        }
+    }
+    FluidVehicle::new(mb, vec![TankFluid { tank: BodyId(0), body, contact }]).unwrap()
+}
+
+fn dense(pattern: &[(usize, usize)], values: &[f64], n: usize) -> Vec<f64> {
+    let mut m = vec![0.0; n * n];
+    for (&(r, c), v) in pattern.iter().zip(values) {
+        m[r * n + c] += v;
+    }
+    m
+}
+
+#[test]
+fn coupled_jacobians_match_finite_differences() {
+    let mut sys = system(false);
+    let n = sys.n_coords();
+    let (mut q, mut v) = sys.initial_coordinates();
+    // Push the liquid 3 mm down and 2 mm sideways into the shell, with a deforming velocity.
+    for (i, x) in q[7..].iter_mut().enumerate() {
+        if i % 12 == 2 {
+            *x -= 3e-3;
+        }
+        if i % 12 == 1 {
+            *x += 2e-3;
+        }
+    }
+    for (i, x) in v[7..].iter_mut().enumerate() {
+        *x += 0.01 * ((i as f64) * 0.7).sin();
+    }
+    let pat = sys.pattern().dynamics;
+    let (mut dq, mut dv) = (vec![0.0; pat.len()], vec![0.0; pat.len()]);
+    sys.force_jacobians(0.0, &q, &v, &mut dq, &mut dv).unwrap();
+    let (kq, kv) = (dense(&pat, &dq, n), dense(&pat, &dv, n));
+    let mut f0 = vec![0.0; n];
+    sys.forces(0.0, &q, &v, &mut f0).unwrap();
+    let scale = f0.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    // Tank columns (0..7) and a spread of fluid columns.
+    let cols: Vec<usize> = (0..7).chain((7..n).step_by(13)).collect();
+    let mut worst: f64 = 0.0;
+    for &c in &cols {
+        for velocity in [false, true] {
+            let h = if velocity { 1e-6 } else { 1e-7 };
+            let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
+            let (mut xp, mut xm) = if velocity { (v.clone(), v.clone()) } else { (q.clone(), q.clone()) };
+            xp[c] += h;
+            xm[c] -= h;
+            if velocity {
+                sys.forces(0.0, &q, &xp, &mut fp).unwrap();
+                sys.forces(0.0, &q, &xm, &mut fm).unwrap();
+            } else {
+                sys.forces(0.0, &xp, &v, &mut fp).unwrap();
+                sys.forces(0.0, &xm, &v, &mut fm).unwrap();
+            }
+            let k = if velocity { &kv } else { &kq };
+            let col_scale = (0..n).map(|r| ((fp[r] - fm[r]) / (2.0 * h)).abs()).fold(0.0f64, f64::max).max(1.0);
+            for r in 0..n {
+                let fd = (fp[r] - fm[r]) / (2.0 * h);
+                let err = (fd - k[r * n + c]).abs() / col_scale;
+                if err > worst {
+                    worst = err;
+                }
+                assert!(err < 2e-4, "column {c} (velocity {velocity}) row {r}: fd {fd:.6e} vs {:.6e}", k[r * n + c]);
+            }
+        }
+    }
+    println!("worst relative Jacobian error {worst:.2e} (force scale {scale:.3e})");
+}
+
+#[test]
+fn fluid_weight_is_carried_by_the_tank_springs() {
+    let sys = system(true);
+    let (q0, v0) = sys.initial_coordinates();
+    let fluid_mass = sys.fluids[0].body.total_mass();
+    let params = rail_mbs::vehicle::TrainScenario::default_hht();
+    let mut hht = Hht::new(sys, 0.0, q0, v0, params).unwrap();
+    hht.integrate_to(1.0, 2e-3).unwrap();
+    let (q, v) = (hht.q().to_vec(), hht.v().to_vec());
+    let sys = hht.system();
+    let load = sys.fluid_load(0, &q, &v);
+    let w = fluid_mass * 9.80665;
+    println!("fluid load on tank {:?} N, fluid weight {w:.1} N", load.force);
+    assert!((-load.force[2] - w).abs() < 0.01 * w, "vertical load {} vs {w}", -load.force[2]);
+    assert!(load.force[0].abs() < 0.01 * w && load.force[1].abs() < 0.01 * w);
+    // The springs carry tank + fluid: the tank sank by (m_t + m_f) g / (4 k).
+    let sag = 2.0 - q[2];
+    let expected = (2000.0 + fluid_mass) * 9.80665 / 4e7;
+    println!("tank sag {sag:.4e} m vs {expected:.4e} m");
+    assert!((sag - expected).abs() < 0.02 * expected);
+}
