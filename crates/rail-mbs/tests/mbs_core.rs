@@ -108,6 +108,8 @@ fn body_on_bushings_settles_at_the_static_deflection() {
             rotational_stiffness: [0.0; 3],
             rotational_damping: [0.0; 3],
             free_axis: None,
+            matrix_stiffness: None,
+            matrix_damping: None,
         }))
         .unwrap();
     }

@@ -56,6 +56,8 @@ fn system(with_springs: bool) -> FluidVehicle {
                     rotational_stiffness: [0.0; 3],
                     rotational_damping: [0.0; 3],
                     free_axis: None,
+                    matrix_stiffness: None,
+                    matrix_damping: None,
                 }))
                 .unwrap();
             }

@@ -7,7 +7,7 @@
 //! ([`Wrench`]). The multibody system turns wrenches into generalized forces and gets
 //! their Jacobians by finite differences (see [`Multibody`](super::Multibody)).
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
 use super::body::{Attachment, BodyState};
 use ancf_core::error::{AncfError, invalid};
@@ -214,6 +214,11 @@ pub struct Bushing {
     pub rotational_damping: [f64; 3],
     /// Axis (0, 1, 2) about which relative rotation is free, if any.
     pub free_axis: Option<usize>,
+    /// Full 6×6 stiffness on `[d; θ]` → `[F; M]` (bushing axes), replacing the diagonal
+    /// values when given (N/m, N, N·m/rad blocks).
+    pub matrix_stiffness: Option<Matrix6<f64>>,
+    /// Full 6×6 damping on `[ḋ; ω_rel]`, replacing the diagonal values when given.
+    pub matrix_damping: Option<Matrix6<f64>>,
 }
 
 impl Bushing {
@@ -230,25 +235,49 @@ impl Bushing {
                 return Err(invalid(&format!("{} {label}", self.name), v, "finite, >= 0"));
             }
         }
+        for (label, m) in [("matrix_stiffness", &self.matrix_stiffness), ("matrix_damping", &self.matrix_damping)] {
+            if let Some(m) = m
+                && m.iter().any(|v| !v.is_finite())
+            {
+                return Err(invalid(&format!("{} {label}", self.name), "non-finite entry", "finite"));
+            }
+        }
         if let Some(k) = self.free_axis.filter(|&k| k > 2) {
             return Err(invalid(&format!("{} free_axis", self.name), k, "0, 1 or 2"));
         }
         Ok(())
     }
 
-    /// Deflection `d` and its rate in bushing axes, and the global axes.
-    fn deflection(&self, si: &BodyState, sj: &BodyState) -> (Vector3<f64>, Vector3<f64>, Matrix3<f64>) {
+    /// Local force and moment on body `j` (bushing axes) and the global axes: with
+    /// `u = [d; θ]`, `u̇ = [ḋ; ω_j − ω_i]` (bushing axes) the load is `−K u − C u̇ + [f₀; 0]`,
+    /// where `K`, `C` are the full 6×6 matrices when given, else the diagonal values.
+    fn local_load(&self, si: &BodyState, sj: &BodyState) -> (Vector3<f64>, Vector3<f64>, Matrix3<f64>) {
         let r = si.rotation * self.frame_i;
+        let rj = sj.rotation * self.frame_j;
         let d = r.transpose() * (sj.point(&self.points[1]) - si.point(&self.points[0])) - self.offset;
         let dd = r.transpose() * (sj.point_velocity(&self.points[1]) - si.point_velocity(&self.points[0]));
-        (d, dd, r)
-    }
-
-    /// Force on body `j` (global).
-    fn force_on_j(&self, si: &BodyState, sj: &BodyState) -> Vector3<f64> {
-        let (d, dd, r) = self.deflection(si, sj);
-        let local = Vector3::from_fn(|k, _| -self.stiffness[k] * d[k] - self.damping[k] * dd[k] + self.preload[k]);
-        r * local
+        let theta = match self.free_axis {
+            Some(k) => r.column(k).cross(&rj.column(k)),
+            None => 0.5 * (0..3).map(|k| r.column(k).cross(&rj.column(k))).sum::<Vector3<f64>>(),
+        };
+        let mut th = r.transpose() * theta;
+        let mut w = r.transpose() * (sj.angular_velocity - si.angular_velocity);
+        if let Some(k) = self.free_axis {
+            th[k] = 0.0;
+            w[k] = 0.0;
+        }
+        let u = Vector6::new(d[0], d[1], d[2], th[0], th[1], th[2]);
+        let ud = Vector6::new(dd[0], dd[1], dd[2], w[0], w[1], w[2]);
+        let diag =
+            |t: [f64; 3], rr: [f64; 3]| Matrix6::from_diagonal(&Vector6::new(t[0], t[1], t[2], rr[0], rr[1], rr[2]));
+        let k = self.matrix_stiffness.unwrap_or_else(|| diag(self.stiffness, self.rotational_stiffness));
+        let c = self.matrix_damping.unwrap_or_else(|| diag(self.damping, self.rotational_damping));
+        let mut load = -(k * u) - c * ud;
+        if let Some(a) = self.free_axis {
+            load[3 + a] = 0.0;
+        }
+        let f = Vector3::new(load[0], load[1], load[2]) + self.preload;
+        (f, Vector3::new(load[3], load[4], load[5]), r)
     }
 }
 
@@ -260,33 +289,16 @@ impl ForceElement for Bushing {
         self.bodies
     }
     fn wrenches(&self, _t: f64, si: &BodyState, sj: &BodyState) -> [Wrench; 2] {
-        let f = self.force_on_j(si, sj);
+        let (fl, ml, r) = self.local_load(si, sj);
+        let (f, m) = (r * fl, r * ml);
         let mut wj = Wrench::at(f, sj.rotation * self.points[1]);
         let mut wi = Wrench::at(-f, si.rotation * self.points[0]);
-        if self.rotational_stiffness.iter().chain(&self.rotational_damping).any(|&k| k != 0.0) {
-            let r = si.rotation * self.frame_i;
-            let rj = sj.rotation * self.frame_j;
-            let theta = match self.free_axis {
-                Some(k) => r.column(k).cross(&rj.column(k)),
-                None => 0.5 * (0..3).map(|k| r.column(k).cross(&rj.column(k))).sum::<Vector3<f64>>(),
-            };
-            let th = r.transpose() * theta;
-            let w = r.transpose() * (sj.angular_velocity - si.angular_velocity);
-            let local = Vector3::from_fn(|k, _| {
-                if self.free_axis == Some(k) {
-                    0.0
-                } else {
-                    -self.rotational_stiffness[k] * th[k] - self.rotational_damping[k] * w[k]
-                }
-            });
-            let m = r * local;
-            wj.moment += m;
-            wi.moment -= m;
-        }
+        wj.moment += m;
+        wi.moment -= m;
         [wi, wj]
     }
     fn output(&self, _t: f64, si: &BodyState, sj: &BodyState) -> f64 {
-        self.force_on_j(si, sj).norm()
+        self.local_load(si, sj).0.norm()
     }
 }
 
@@ -307,13 +319,17 @@ pub struct BrakeTorque {
     pub torque: Table,
     /// Spin-rate scale `ω_s` of the sign smoothing, rad/s.
     pub smoothing: f64,
+    /// Optional factor on the torque against the wheelset's forward speed (m/s), e.g.
+    /// the speed dependence of the shoe friction coefficient; `T = T(t) · φ(V)`.
+    pub speed_factor: Option<Table>,
 }
 
 impl BrakeTorque {
     fn moment_on_wheelset(&self, t: f64, si: &BodyState, sj: &BodyState) -> Vector3<f64> {
         let a = si.rotation * self.axis;
         let w_rel = (si.angular_velocity - sj.angular_velocity).dot(&a);
-        -self.torque.eval(t) * (w_rel / self.smoothing).tanh() * a
+        let phi = self.speed_factor.as_ref().map_or(1.0, |f| f.eval(si.velocity.norm()));
+        -self.torque.eval(t) * phi * (w_rel / self.smoothing).tanh() * a
     }
 }
 
@@ -392,6 +408,8 @@ mod tests {
             rotational_stiffness: [1e4, 2e4, 3e4],
             rotational_damping: [0.0; 3],
             free_axis: None,
+            matrix_stiffness: None,
+            matrix_damping: None,
         };
         let si = st(Vector3::zeros(), Matrix3::identity(), Vector3::zeros(), Vector3::zeros());
         let sj = st(Vector3::new(0.0, 0.0, 1e-3), Matrix3::identity(), Vector3::zeros(), Vector3::zeros());
@@ -416,6 +434,20 @@ mod tests {
         );
         let [wi, wj] = b.wrenches(0.0, &si, &sj);
         assert!((wi.force + wj.force).norm() < 1e-9);
+        // A full 6×6 stiffness couples directions: K[1][2] = 5e5 gives a lateral force from a
+        // vertical deflection, and equals the diagonal form when diagonal.
+        let mut full = b.clone();
+        let mut k6 = Matrix6::from_diagonal(&Vector6::new(1e6, 2e6, 3e6, 1e4, 2e4, 3e4));
+        let c6 = Matrix6::from_diagonal(&Vector6::new(1e3, 1e3, 1e3, 0.0, 0.0, 0.0));
+        full.matrix_stiffness = Some(k6);
+        full.matrix_damping = Some(c6);
+        let [a, bb] = full.wrenches(0.0, &si, &sj);
+        assert!((a.force - wi.force).norm() < 1e-9 && (bb.moment - wj.moment).norm() < 1e-9);
+        k6[(1, 2)] = 5e5;
+        full.matrix_stiffness = Some(k6);
+        let sz = st(Vector3::new(0.0, 0.0, 1e-3), Matrix3::identity(), Vector3::zeros(), Vector3::zeros());
+        let [_, wz] = full.wrenches(0.0, &si, &sz);
+        assert!((wz.force.y + 5e5 * 1e-3).abs() < 1e-9, "{}", wz.force);
         // Total moment about the global origin: the couple of the force pair over the deflection.
         let total = wi.moment + si.position.cross(&wi.force) + wj.moment + sj.position.cross(&wj.force);
         let couple = (sj.point(&b.points[1]) - si.point(&b.points[0])).cross(&wj.force);
@@ -428,11 +460,22 @@ mod tests {
         assert_eq!(t.eval(1.0), 500.0);
         assert_eq!(t.eval(5.0), 1000.0);
         assert!(Table::new("torque", vec![1.0, 0.0], vec![0.0, 0.0]).is_err());
-        let b =
-            BrakeTorque { name: "brake".into(), bodies: [None, None], axis: Vector3::y(), torque: t, smoothing: 0.1 };
+        let mut b = BrakeTorque {
+            name: "brake".into(),
+            bodies: [None, None],
+            axis: Vector3::y(),
+            torque: t,
+            smoothing: 0.1,
+            speed_factor: None,
+        };
         let si = st(Vector3::zeros(), Matrix3::identity(), Vector3::zeros(), Vector3::new(0.0, 20.0, 0.0));
         let sj = st(Vector3::zeros(), Matrix3::identity(), Vector3::zeros(), Vector3::zeros());
         let [wi, wj] = b.wrenches(2.0, &si, &sj);
         assert!((wi.moment.y + 1000.0).abs() < 1e-6 && (wj.moment.y - 1000.0).abs() < 1e-6);
+        // A speed factor scales it: half the torque at 10 m/s.
+        b.speed_factor = Some(Table::new("speed_factor", vec![0.0, 20.0], vec![1.0, 0.0]).unwrap());
+        let si = st(Vector3::zeros(), Matrix3::identity(), Vector3::new(10.0, 0.0, 0.0), Vector3::new(0.0, 20.0, 0.0));
+        let [wi, _] = b.wrenches(2.0, &si, &sj);
+        assert!((wi.moment.y + 500.0).abs() < 1e-6);
     }
 }

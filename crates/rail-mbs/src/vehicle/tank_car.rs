@@ -352,6 +352,8 @@ fn bushing(
         rotational_stiffness: [0.0; 3],
         rotational_damping: [0.0; 3],
         free_axis: None,
+        matrix_stiffness: None,
+        matrix_damping: None,
     }
 }
 
@@ -576,6 +578,7 @@ pub fn add_tank_car(
                 axis: Vector3::y(),
                 torque: torque.clone(),
                 smoothing: 0.5,
+                speed_factor: None,
             }))?);
         }
     }
