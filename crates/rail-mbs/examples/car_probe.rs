@@ -25,6 +25,9 @@ fn main() {
     let mut mb = Multibody::new();
     let mut p = TankCarParams::standard().unwrap();
     p.lading = Some((36_000.0, -0.5));
+    if std::env::var("NOSCAN").is_ok() {
+        p.contact.always_scan = false;
+    }
     if std::env::var("WHEEL").as_deref() == Ok("aar") {
         p.contact.wheel_profile = rail_mbs::profile::aar1b_wheel_approx().unwrap();
     }

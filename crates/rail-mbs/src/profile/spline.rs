@@ -11,6 +11,9 @@ pub struct CubicSpline {
     z: Vec<f64>,
     /// Second derivatives at the knots.
     m: Vec<f64>,
+    /// `1/h` when the knots are uniformly spaced (to 1e-9 relative): the interval of a
+    /// point is then found in O(1) instead of by bisection.
+    inv_uniform_step: Option<f64>,
 }
 
 impl CubicSpline {
@@ -61,7 +64,9 @@ impl CubicSpline {
             }
             m[1..(k + 1)].copy_from_slice(&sol);
         }
-        Ok(Self { y: y.to_vec(), z: z.to_vec(), m })
+        let h = (y[n - 1] - y[0]) / (n - 1) as f64;
+        let uniform = y.iter().enumerate().all(|(i, v)| (v - (y[0] + h * i as f64)).abs() <= 1e-9 * h);
+        Ok(Self { y: y.to_vec(), z: z.to_vec(), m, inv_uniform_step: uniform.then_some(1.0 / h) })
     }
 
     /// Knot abscissae.
@@ -89,7 +94,19 @@ impl CubicSpline {
             let (z, d, _) = self.eval_in(n - 2, yn);
             return (z + d * (y - yn), d, 0.0);
         }
-        let i = (self.y.partition_point(|&v| v <= y).max(1) - 1).min(n - 2);
+        let i = match self.inv_uniform_step {
+            Some(inv) => {
+                // Guess from the uniform spacing, then correct for rounding at a knot.
+                let mut i = (((y - y0) * inv) as usize).min(n - 2);
+                if y < self.y[i] && i > 0 {
+                    i -= 1;
+                } else if y >= self.y[i + 1] && i + 2 < n {
+                    i += 1;
+                }
+                i
+            }
+            None => (self.y.partition_point(|&v| v <= y).max(1) - 1).min(n - 2),
+        };
         self.eval_in(i, y)
     }
 
@@ -116,5 +133,30 @@ impl CubicSpline {
     /// Second derivative at `y`.
     pub fn second_derivative(&self, y: f64) -> f64 {
         self.eval(y).2
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn uniform_knot_lookup_equals_bisection() {
+        let y: Vec<f64> = (0..200).map(|i| -0.07 + 6.5e-4 * i as f64).collect();
+        let z: Vec<f64> = y.iter().map(|v| (40.0 * v).sin() * 1e-2 + v * v).collect();
+        let uni = CubicSpline::new(&y, &z).unwrap();
+        assert!(uni.inv_uniform_step.is_some());
+        let mut slow = uni.clone();
+        slow.inv_uniform_step = None;
+        for k in 0..5000 {
+            let v = -0.075 + 0.14 * k as f64 / 4999.0;
+            assert_eq!(uni.eval(v), slow.eval(v), "at {v}");
+        }
+        for &v in &y {
+            assert_eq!(uni.eval(v), slow.eval(v), "at knot {v}");
+        }
+        let mut ny = y.clone();
+        ny[5] += 1e-5;
+        assert!(CubicSpline::new(&ny, &z).unwrap().inv_uniform_step.is_none());
     }
 }

@@ -58,6 +58,10 @@ pub struct ContactParams {
     pub damping: f64,
     /// Samples of the profile scan. Default 200.
     pub scan_points: usize,
+    /// Scan the profiles at every evaluation (robust: sees a new contact point such as the
+    /// flange appear) or only when the warm-started Newton solutions fail (faster; enough
+    /// on tangent track). Default true.
+    pub always_scan: bool,
 }
 
 impl ContactParams {
@@ -74,6 +78,7 @@ impl ContactParams {
             friction: 0.3,
             damping: 50.0,
             scan_points: 200,
+            always_scan: true,
         })
     }
 }
@@ -381,6 +386,7 @@ fn contact_pair(p: &TankCarParams, track: &Arc<Track>, side: Side) -> Result<Whe
     w.friction = c.friction;
     w.damping = c.damping;
     w.settings.scan_points = c.scan_points;
+    w.settings.always_scan = c.always_scan;
     Ok(w)
 }
 
