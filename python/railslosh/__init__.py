@@ -5,7 +5,7 @@ analysis and the ``railslosh`` command-line tool. Units are SI throughout; frame
 conventions are defined in ``docs/frames.md``.
 """
 
-from railslosh import fluids, mesh, rail, slosh, vehicle
+from railslosh import fluids, mesh, rail, scene, slosh, vehicle
 from railslosh._core import (
     Fluid,
     FluidBody,
@@ -25,6 +25,7 @@ __all__ = [
     "mass_matrix",
     "mesh",
     "rail",
+    "scene",
     "slosh",
     "vehicle",
 ]

@@ -278,3 +278,29 @@ def run_train(
     coupler_damping: float | None = None,
     car: dict[str, float] | None = None,
 ) -> dict[str, Any]: ...
+def design_brake_torque(
+    mass: float, v0: float = ..., v1: float = ..., duration: float = 10.0
+) -> tuple[list[float], list[float]]: ...
+def run_fluid_train(
+    track: list[list[float]],
+    *,
+    cars: int = 1,
+    station: float = 300.0,
+    speed: float = 0.0,
+    t_end: float = 1.0,
+    step: float = 4e-3,
+    record_every: float = 0.02,
+    snapshot_every: float = 0.0,
+    drive_speed: float | None = None,
+    brake_times: list[float] | None = None,
+    brake_torques: list[float] | None = None,
+    brake_scope: str = "all",
+    brake_factors: list[float] | None = None,
+    oil: str = "light",
+    fluid: Fluid | None = None,
+    counts: tuple[int, int, int] = (6, 4, 2),
+    fill: float = 0.5,
+    bulkheads: list[tuple[float, float]] | None = None,
+    wheel_profile: str = "s1002",
+    car: dict[str, float] | None = None,
+) -> dict[str, Any]: ...

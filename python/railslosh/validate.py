@@ -71,6 +71,15 @@ _DESCRIPTIONS = {
     "balance-speed-curving": "tank car on a 1000 m curve (balance speed 60 km/h): outer/inner wheel loads equal "
     "within 5 % at the balance speed, outer heavier above it, inner heavier below it",
     "lateral-stability": "tank car at 60 km/h on tangent track: a 2 mm lateral wheelset disturbance decays",
+    "ecp-braking-oils": "two cars with half-full tanks of crude, ECP braking 40 -> 5 km/h in 10 s: peak coupler force "
+    "heavy 15-45 % below light (paper ~30 %), coupler oscillation dies out sooner for the heavy crude",
+    "conventional-braking": "front car only braking: coupler compressive, mean magnitude several times ECP, "
+    "oils differ little",
+    "bulkhead-reduction": "light crude, ECP: two bulkheads cut the peak coupler force by 50-85 % (paper ~70 %) and the "
+    "front/rear bogie normal-force difference",
+    "curve-outward-inertia": "one car on the Table 1 curve at 60 and 100 km/h: outward inertia force of the oil vs the "
+    "in-plane gravity component, growing with density",
+    "mesh-convergence": "one car braking with light crude on three meshes: oil centre-of-mass trajectories agree",
     "klingel-wavelength": "kinematic (no-slip) free coned wheelset: lateral oscillation wavelength vs Klingel's "
     "2 pi sqrt(r0 b / lambda)",
 }

@@ -24,7 +24,7 @@ import numpy as np
 from railslosh import _core
 from railslosh.slosh import SimulationError
 
-__all__ = ["run", "tank_car_parameters"]
+__all__ = ["design_brake_torque", "run", "run_fluid", "tank_car_parameters"]
 
 
 def tank_car_parameters(car: dict[str, float] | None = None, wheel_profile: str = "s1002") -> dict[str, float]:
@@ -107,4 +107,80 @@ def run(
     if "error" in res:
         t_last = res["t"][-1] if len(res["t"]) else 0.0
         raise SimulationError(f"vehicle run stopped at t = {t_last:.4f} s: {res['error']}", res)
+    return res
+
+
+def design_brake_torque(
+    mass: float, v0: float = 40 / 3.6, v1: float = 5 / 3.6, duration: float = 10.0
+) -> tuple[list[float], list[float]]:
+    """Brake torque per wheelset, ``(times, torques)``, that slows a car of total mass ``mass`` (kg,
+    liquid included) from ``v0`` to ``v1`` (m/s) in ``duration`` s: ``T0 (1 - exp(-(t - 0.5)/0.5))``
+    after a 0.5 s settling time (the design of seed 000 §8.2; see ``rail_mbs::vehicle::studies``)."""
+    return _core.design_brake_torque(mass, v0, v1, duration)
+
+
+def run_fluid(
+    track: Any,
+    *,
+    cars: int = 1,
+    station: float = 300.0,
+    speed: float = 0.0,
+    t_end: float = 1.0,
+    step: float = 4e-3,
+    record_every: float = 0.02,
+    snapshot_every: float = 0.0,
+    drive: bool | float = False,
+    brake: tuple[Sequence[float], Sequence[float]] | None = None,
+    brake_scope: str = "all",
+    brake_factors: Sequence[float] | None = None,
+    oil: str = "light",
+    fluid: Any = None,
+    counts: tuple[int, int, int] = (6, 4, 2),
+    fill: float = 0.5,
+    bulkheads: Sequence[tuple[float, float]] | None = None,
+    wheel_profile: str = "s1002",
+    car: dict[str, float] | None = None,
+) -> dict[str, Any]:
+    """Run tank cars whose tanks carry an ANCF fluid, solved monolithically with the cars.
+
+    ``oil`` is ``"light"``, ``"medium"``, ``"heavy"`` (seed 000 Table 2, Oldroyd) or ``"water"``;
+    ``fluid`` (a :class:`railslosh.Fluid`, e.g. from :mod:`railslosh.fluids`) overrides it.
+    ``counts`` = fluid elements along the length, width and height; ``bulkheads`` = ``[(x, thickness)]``
+    in the tank frame (m). Returns the arrays of :func:`run` plus ``oil_com_tank`` and ``oil_com_global``
+    (samples, cars, 3), ``fluid_force_tank`` (the fluid's load on each tank, tank frame), ``volume_error``
+    and ``snapshots`` (``[(t, [nodes x 4 x 3 per car])]``, position then gradients per node).
+    """
+    drive_speed = None
+    if drive is True:
+        drive_speed = float(speed)
+    elif drive is not False:
+        drive_speed = float(drive)
+    times, torques = (None, None) if brake is None else (list(map(float, brake[0])), list(map(float, brake[1])))
+    res = dict(
+        _core.run_fluid_train(
+            _table(track),
+            cars=cars,
+            station=station,
+            speed=speed,
+            t_end=t_end,
+            step=step,
+            record_every=record_every,
+            snapshot_every=snapshot_every,
+            drive_speed=drive_speed,
+            brake_times=times,
+            brake_torques=torques,
+            brake_scope=brake_scope,
+            brake_factors=None if brake_factors is None else list(map(float, brake_factors)),
+            oil=oil,
+            fluid=fluid,
+            counts=tuple(counts),
+            fill=fill,
+            bulkheads=None if bulkheads is None else [(float(x), float(t)) for x, t in bulkheads],
+            wheel_profile=wheel_profile,
+            car=car,
+        )
+    )
+    if "error" in res:
+        t_last = res["t"][-1] if len(res["t"]) else 0.0
+        raise SimulationError(f"fluid vehicle run stopped at t = {t_last:.4f} s: {res['error']}", res)
     return res

@@ -20,9 +20,9 @@ fn main() {
     let oil = a.get(5).map_or("light", |s| s.as_str());
     let scope = if a.get(6).map(|s| s.as_str()) == Some("front") { BrakeScope::FrontCar } else { BrakeScope::AllCars };
     let (rho, mu, tau) = match oil {
-        "light" => (790.0, 0.005, 0.0),
-        "medium" => (870.0, 0.1, 10.0),
-        "heavy" => (970.0, 100.0, 100.0),
+        "light" => (850.0, 0.005, 0.0),
+        "medium" => (900.0, 10.0, 30.0),
+        "heavy" => (1000.0, 100.0, 100.0),
         _ => (998.0, 1e-3, 0.0),
     };
     let rheology = if tau > 0.0 {
@@ -51,6 +51,15 @@ fn main() {
     let tq = 7000.0;
     let brake = Table::new("brake", vec![0.0, 0.5, 1.0], vec![0.0, 0.0, tq]).unwrap();
     sc.brake = Some((brake, scope));
+    if let Ok(r) = std::env::var("REFRESH") {
+        sc.hht.refresh_rate = r.parse().unwrap();
+    }
+    if let Ok(r) = std::env::var("STEP") {
+        sc.step = r.parse().unwrap();
+    }
+    if let Ok(r) = std::env::var("RELTOL") {
+        sc.hht.rel_tol = r.parse().unwrap();
+    }
     let out = run_fluid_train(&sc, &cargo).unwrap();
     let rec = match out {
         Ok(r) => r,

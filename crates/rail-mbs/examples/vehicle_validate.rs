@@ -1,11 +1,16 @@
-//! Run one vehicle validation case and print its records:
+//! Run one vehicle or crude-oil study validation case and print its records:
 //! `cargo run --release -p rail-mbs --example vehicle_validate -- CASE [quick]`.
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let name = args.first().map(String::as_str).unwrap_or("static-wheel-loads");
     let quick = args.iter().any(|a| a == "quick");
     let t = std::time::Instant::now();
-    match rail_mbs::vehicle::validate::run_case(name, quick) {
+    let result = if rail_mbs::vehicle::studies::CASES.contains(&name) {
+        rail_mbs::vehicle::studies::run_case(name, quick)
+    } else {
+        rail_mbs::vehicle::validate::run_case(name, quick)
+    };
+    match result {
         Ok(recs) => {
             for r in recs {
                 println!(

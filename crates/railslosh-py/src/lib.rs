@@ -512,6 +512,7 @@ fn validation_cases() -> Vec<&'static str> {
         .chain(rail_mbs::slosh::validate::CASES.iter())
         .chain(rail_mbs::wheel_rail::validate::CASES.iter())
         .chain(rail_mbs::vehicle::validate::CASES.iter())
+        .chain(rail_mbs::vehicle::studies::CASES.iter())
         .copied()
         .collect()
 }
@@ -529,6 +530,8 @@ fn run_validation<'py>(py: Python<'py>, name: String, quick: bool) -> PyResult<V
                 rail_mbs::slosh::validate::run_case(&name, quick)
             } else if rail_mbs::vehicle::validate::CASES.contains(&name.as_str()) {
                 rail_mbs::vehicle::validate::run_case(&name, quick)
+            } else if rail_mbs::vehicle::studies::CASES.contains(&name.as_str()) {
+                rail_mbs::vehicle::studies::run_case(&name, quick)
             } else {
                 ancf_core::validate::run_case(&name, quick)
             }

@@ -10,7 +10,11 @@ use pyo3::types::PyDict;
 use rail_mbs::mbs::{SpeedProfile, Table};
 use rail_mbs::profile::aar1b_wheel_approx;
 use rail_mbs::track::{Track, TrackPoint};
-use rail_mbs::vehicle::{BrakeScope, TankCarParams, TrainRecord, TrainScenario, run_train as rust_run_train};
+use rail_mbs::vehicle::studies::{Oil, brake_torque};
+use rail_mbs::vehicle::{
+    BrakeScope, FluidCargo, FluidTrainRecord, TankCarParams, TrainRecord, TrainScenario,
+    run_fluid_train as rust_run_fluid_train, run_train as rust_run_train,
+};
 
 use crate::compute;
 
@@ -220,9 +224,137 @@ pub fn run_train<'py>(
     }
 }
 
+fn oil_of(name: &str) -> PyResult<Oil> {
+    Ok(match name {
+        "light" => Oil::Light,
+        "medium" => Oil::Medium,
+        "heavy" => Oil::Heavy,
+        "water" => Oil::Water,
+        other => return Err(crate::to_py(invalid("oil", other, "'light', 'medium', 'heavy' or 'water'"))),
+    })
+}
+
+fn fluid_record_dict<'py>(py: Python<'py>, r: &FluidTrainRecord) -> PyResult<Bound<'py, PyDict>> {
+    let d = record_dict(py, &r.train)?;
+    let nt = r.oil_com_tank.len();
+    let nc = r.oil_com_tank.first().map_or(0, |x| x.len());
+    let flat = |a: &Vec<Vec<[f64; 3]>>| a.iter().flat_map(|s| s.iter().flat_map(|c| c.iter().copied())).collect();
+    d.set_item("oil_com_tank", arr(py, flat(&r.oil_com_tank), &[nt, nc, 3])?)?;
+    d.set_item("oil_com_global", arr(py, flat(&r.oil_com_global), &[nt, nc, 3])?)?;
+    d.set_item("fluid_force_tank", arr(py, flat(&r.fluid_force_tank), &[nt, nc, 3])?)?;
+    let vol: Vec<f64> = r.volume_error.iter().flat_map(|s| s.iter().copied()).collect();
+    d.set_item("volume_error", arr(py, vol, &[nt, nc])?)?;
+    let snaps = pyo3::types::PyList::empty(py);
+    for (t, cars) in &r.snapshots {
+        let arrays: Vec<Bound<'py, PyAny>> =
+            cars.iter().map(|e| arr(py, e.clone(), &[e.len() / 12, 4, 3])).collect::<PyResult<_>>()?;
+        snaps.append((*t, arrays))?;
+    }
+    d.set_item("snapshots", snaps)?;
+    d.set_item("fluid_mass", r.fluid_mass)?;
+    d.set_item("elements", r.elements)?;
+    Ok(d)
+}
+
+/// Brake torque table `(times, torques)` per wheelset that slows a car of total mass
+/// `mass` (kg) from `v0` to `v1` (m/s) in `duration` s (seed 000 §8.2 design, see
+/// `rail_mbs::vehicle::studies::brake_torque`).
+#[pyfunction]
+#[pyo3(signature = (mass, v0=40.0 / 3.6, v1=5.0 / 3.6, duration=10.0))]
+pub fn design_brake_torque(mass: f64, v0: f64, v1: f64, duration: f64) -> PyResult<(Vec<f64>, Vec<f64>)> {
+    let p = TankCarParams::standard().map_err(crate::to_py)?;
+    ancf_core::error::check_positive("mass", mass).map_err(crate::to_py)?;
+    ancf_core::error::check_positive("duration", duration).map_err(crate::to_py)?;
+    let t = brake_torque(&p, mass, v0, v1, duration).map_err(crate::to_py)?;
+    Ok((t.x, t.y))
+}
+
+/// Runs a train whose tanks carry an ANCF fluid (monolithic with the cars). `oil` names a
+/// liquid of seed 000 Table 2 (or water) unless `fluid` (a `railslosh.Fluid`) is given.
+/// Returns the `run_train` arrays plus the oil centre of mass (tank and global frames),
+/// the fluid load on each tank, volume errors and mesh snapshots.
+#[pyfunction]
+#[pyo3(signature = (
+    track, *, cars=1, station=300.0, speed=0.0, t_end=1.0, step=4e-3, record_every=0.02, snapshot_every=0.0,
+    drive_speed=None, brake_times=None, brake_torques=None, brake_scope="all", brake_factors=None,
+    oil="light", fluid=None, counts=(6, 4, 2), fill=0.5, bulkheads=None, wheel_profile="s1002", car=None
+))]
+#[allow(clippy::too_many_arguments)]
+pub fn run_fluid_train<'py>(
+    py: Python<'py>,
+    track: Vec<Vec<f64>>,
+    cars: usize,
+    station: f64,
+    speed: f64,
+    t_end: f64,
+    step: f64,
+    record_every: f64,
+    snapshot_every: f64,
+    drive_speed: Option<f64>,
+    brake_times: Option<Vec<f64>>,
+    brake_torques: Option<Vec<f64>>,
+    brake_scope: &str,
+    brake_factors: Option<Vec<f64>>,
+    oil: &str,
+    fluid: Option<Bound<'py, crate::PyFluid>>,
+    counts: (usize, usize, usize),
+    fill: f64,
+    bulkheads: Option<Vec<(f64, f64)>>,
+    wheel_profile: &str,
+    car: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let params = car_params(car, wheel_profile)?;
+    let scope = match brake_scope {
+        "all" => BrakeScope::AllCars,
+        "front" => BrakeScope::FrontCar,
+        other => return Err(crate::to_py(invalid("brake_scope", other, "'all' or 'front'"))),
+    };
+    let brake = match (brake_times, brake_torques) {
+        (Some(t), Some(m)) => Some((Table::new("brake_times/brake_torques", t, m).map_err(crate::to_py)?, scope)),
+        (None, None) => None,
+        _ => return Err(crate::to_py(invalid("brake_times/brake_torques", "one missing", "both or neither"))),
+    };
+    if !(fill > 0.05 && fill < 0.95) {
+        return Err(crate::to_py(invalid("fill", fill, "(0.05, 0.95)")));
+    }
+    let depth = 2.0 * params.tank_radius * fill;
+    let fluid = match fluid {
+        Some(f) => f.get().inner,
+        None => oil_of(oil)?.fluid(depth, depth / counts.2.max(1) as f64).map_err(crate::to_py)?,
+    };
+    let cargo = FluidCargo {
+        fluid,
+        counts: [counts.0, counts.1, counts.2],
+        fill,
+        bulkheads: bulkheads.unwrap_or_default(),
+        quadrature: ancf_core::element::QuadratureOptions::default(),
+    };
+    let track = Arc::new(track_from_table(track).map_err(crate::to_py)?);
+    let mut sc = TrainScenario::single(params, track, station, speed, t_end);
+    sc.cars = cars;
+    sc.step = step;
+    sc.record_every = record_every;
+    sc.snapshot_every = snapshot_every;
+    sc.drive = drive_speed.map(SpeedProfile::Constant);
+    sc.brake = brake;
+    sc.brake_factors = brake_factors.unwrap_or_default();
+    sc.hht.refresh_rate = 0.5;
+    let out = compute(py, move || rust_run_fluid_train(&sc, &cargo))?;
+    match out {
+        Ok(r) => fluid_record_dict(py, &r),
+        Err(f) => {
+            let d = fluid_record_dict(py, &f.record)?;
+            d.set_item("error", f.error.to_string())?;
+            Ok(d)
+        }
+    }
+}
+
 /// Registers the vehicle functions.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(tank_car_parameters, m)?)?;
     m.add_function(wrap_pyfunction!(run_train, m)?)?;
+    m.add_function(wrap_pyfunction!(run_fluid_train, m)?)?;
+    m.add_function(wrap_pyfunction!(design_brake_torque, m)?)?;
     Ok(())
 }

@@ -60,6 +60,8 @@ struct FluidLayout {
     /// fluid-rows block (row-major).
     tank_rows: usize,
     fluid_rows: usize,
+    /// (pattern index, value) of every fluid mass-matrix entry (constant).
+    mass_entries: Vec<(usize, f64)>,
 }
 
 /// Rigid multibody vehicle plus fluids in its tanks.
@@ -150,6 +152,15 @@ impl FluidVehicle {
                     pat.dynamics.push((offset + r, t0 + c));
                 }
             }
+            let m = f.body.scalar_mass().as_ref();
+            for j in 0..m.ncols() {
+                for (i, val) in m.row_idx_of_col(j).zip(m.val_of_col(j)) {
+                    for k in 0..3 {
+                        let (r, c) = (3 * i + k, 3 * j + k);
+                        lay.mass_entries.push((lay.blocks[&(r / 12, c / 12)] + (r % 12) * 12 + c % 12, *val));
+                    }
+                }
+            }
             offset += nf;
             layouts.push(lay);
         }
@@ -222,15 +233,9 @@ impl MechanicalSystem for FluidVehicle {
     fn mass(&mut self, q: &[f64], values: &mut [f64]) -> Result<(), SystemError> {
         let nr = self.n_rigid;
         self.mb.mass(&q[..nr], &mut values[..self.mb_entries])?;
-        for (f, lay) in self.fluids.iter().zip(&self.layouts) {
-            let m = f.body.scalar_mass().as_ref();
-            for j in 0..m.ncols() {
-                for (i, val) in m.row_idx_of_col(j).zip(m.val_of_col(j)) {
-                    for k in 0..3 {
-                        let (r, c) = (3 * i + k, 3 * j + k);
-                        values[lay.blocks[&(r / 12, c / 12)] + (r % 12) * 12 + c % 12] += val;
-                    }
-                }
+        for lay in &self.layouts {
+            for &(i, val) in &lay.mass_entries {
+                values[i] += val;
             }
         }
         Ok(())
@@ -448,10 +453,15 @@ pub struct FluidTrainRecord {
     pub train: TrainRecord,
     /// Fluid centre of mass in the tank frame, m: `[sample][car]`.
     pub oil_com_tank: Vec<Vec<[f64; 3]>>,
+    /// Fluid centre of mass, global, m: `[sample][car]`.
+    pub oil_com_global: Vec<Vec<[f64; 3]>>,
     /// Fluid load on the tank (contact force), tank frame, N: `[sample][car]`.
     pub fluid_force_tank: Vec<Vec<[f64; 3]>>,
     /// Relative fluid volume change: `[sample][car]`.
     pub volume_error: Vec<Vec<f64>>,
+    /// Fluid mesh snapshots: time and the nodal coordinates of every car's fluid (global,
+    /// the layout of `FluidBody` coordinates: 12 per node, position first).
+    pub snapshots: Vec<(f64, Vec<Vec<f64>>)>,
     /// Fluid mass per car, kg.
     pub fluid_mass: f64,
     /// Fluid elements per car.
@@ -510,6 +520,7 @@ pub fn build_fluid_train(
 fn record_fluid(sys: &FluidVehicle, q: &[f64], v: &[f64], rec: &mut FluidTrainRecord) {
     let nr = sys.mb.n_coords();
     let mut com = Vec::new();
+    let mut com_g = Vec::new();
     let mut load = Vec::new();
     let mut vol = Vec::new();
     for (k, f) in sys.fluids.iter().enumerate() {
@@ -517,11 +528,13 @@ fn record_fluid(sys: &FluidVehicle, q: &[f64], v: &[f64], rec: &mut FluidTrainRe
         let e = sys.fluid_slice(k, q);
         let c = Vector3::from(f.body.center_of_mass(e));
         com.push(<[f64; 3]>::from(s.rotation.transpose() * (c - s.position)));
+        com_g.push(<[f64; 3]>::from(c));
         let l = sys.fluid_load(k, q, v);
         load.push(<[f64; 3]>::from(s.rotation.transpose() * Vector3::from(l.force)));
         vol.push(f.body.volume(e) / f.body.reference_volume() - 1.0);
     }
     rec.oil_com_tank.push(com);
+    rec.oil_com_global.push(com_g);
     rec.fluid_force_tank.push(load);
     rec.volume_error.push(vol);
 }
@@ -582,6 +595,14 @@ pub fn run_fluid_train(
             return Ok(Err(Box::new(FluidTrainFailure { error, record: finish(Some(&hht), rec) })));
         }
         record_fluid(hht.system(), &q, &v, &mut rec);
+        if sc.snapshot_every > 0.0 {
+            let every = (sc.snapshot_every / sc.record_every).round().max(1.0) as usize;
+            if k % every == 0 {
+                let sys = hht.system();
+                let e = (0..sys.fluids.len()).map(|f| sys.fluid_slice(f, &q).to_vec()).collect();
+                rec.snapshots.push((t, e));
+            }
+        }
     }
     Ok(Ok(finish(Some(&hht), rec)))
 }

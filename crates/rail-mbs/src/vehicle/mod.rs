@@ -35,6 +35,7 @@
 
 pub mod fluid;
 mod run;
+pub mod studies;
 mod tank_car;
 pub mod validate;
 

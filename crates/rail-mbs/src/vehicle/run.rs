@@ -38,6 +38,9 @@ pub struct TrainScenario {
     pub drive: Option<SpeedProfile>,
     /// Brake torque per wheelset (N·m against s) and which cars brake.
     pub brake: Option<(Table, BrakeScope)>,
+    /// Per-car factor on the brake torque (missing entries = 1), e.g. to model the spread
+    /// of brake forces between cars.
+    pub brake_factors: Vec<f64>,
     /// Coupler stiffness and damping (defaults of seed 000 §8.2 when `None`).
     pub coupler: (Option<f64>, Option<f64>),
     /// Initial lateral displacement of every wheelset (a disturbance), m.
@@ -48,6 +51,8 @@ pub struct TrainScenario {
     pub step: f64,
     /// Recording interval, s.
     pub record_every: f64,
+    /// Interval of fluid mesh snapshots, s (0 = none; fluid runs only).
+    pub snapshot_every: f64,
     /// Integrator parameters.
     pub hht: HhtParams,
 }
@@ -81,10 +86,12 @@ impl TrainScenario {
             drive: None,
             brake: None,
             coupler: (None, None),
+            brake_factors: Vec::new(),
             wheelset_lateral_offset: 0.0,
             t_end,
             step: 1e-3,
             record_every: 0.01,
+            snapshot_every: 0.0,
             hht: Self::default_hht(),
         }
     }
@@ -99,6 +106,9 @@ impl TrainScenario {
         check_positive("record_every", self.record_every)?;
         if !(self.speed.is_finite() && self.speed.abs() < 100.0) {
             return Err(invalid("speed", self.speed, "|speed| < 100 m/s"));
+        }
+        if let Some(f) = self.brake_factors.iter().find(|f| !(f.is_finite() && **f >= 0.0 && **f <= 10.0)) {
+            return Err(invalid("brake_factors", f, "[0, 10]"));
         }
         if !(self.wheelset_lateral_offset.is_finite() && self.wheelset_lateral_offset.abs() < 0.01) {
             return Err(invalid("wheelset_lateral_offset", self.wheelset_lateral_offset, "|offset| < 0.01 m"));
@@ -189,9 +199,11 @@ pub fn build_train(sc: &TrainScenario) -> Result<(Multibody, Vec<CarBodies>, Vec
     let mut cars = Vec::with_capacity(sc.cars);
     let pitch = 2.0 * sc.car.coupler_reach + 1.0;
     for k in 0..sc.cars {
+        let factor = sc.brake_factors.get(k).copied().unwrap_or(1.0);
+        let scaled = |t: &Table| Table { x: t.x.clone(), y: t.y.iter().map(|y| y * factor).collect() };
         let brake = match &sc.brake {
-            Some((t, BrakeScope::AllCars)) => Some(t.clone()),
-            Some((t, BrakeScope::FrontCar)) if k == 0 => Some(t.clone()),
+            Some((t, BrakeScope::AllCars)) => Some(scaled(t)),
+            Some((t, BrakeScope::FrontCar)) if k == 0 => Some(scaled(t)),
             _ => None,
         };
         let drive = if k == 0 { sc.drive.clone() } else { None };
