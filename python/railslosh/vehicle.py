@@ -45,6 +45,27 @@ def _table(track: Any) -> list[list[float]]:
     return rows.tolist()
 
 
+def _drive_and_brake(
+    drive: bool | float, speed: float, brake: tuple[Sequence[float], Sequence[float]] | None
+) -> tuple[float | None, list[float] | None, list[float] | None]:
+    """Driven speed (None = free) and the brake table as lists."""
+    drive_speed = None
+    if drive is True:
+        drive_speed = float(speed)
+    elif drive is not False:
+        drive_speed = float(drive)
+    if brake is None:
+        return drive_speed, None, None
+    return drive_speed, list(map(float, brake[0])), list(map(float, brake[1]))
+
+
+def _raise_on_error(res: dict[str, Any], what: str) -> dict[str, Any]:
+    if "error" in res:
+        t_last = res["t"][-1] if len(res["t"]) else 0.0
+        raise SimulationError(f"{what} stopped at t = {t_last:.4f} s: {res['error']}", res)
+    return res
+
+
 def run(
     track: Any,
     *,
@@ -76,12 +97,7 @@ def run(
     Raises ``ValueError`` naming a bad field, and :class:`railslosh.slosh.SimulationError` (with
     ``.results`` up to the failure) when the run stops early.
     """
-    drive_speed = None
-    if drive is True:
-        drive_speed = float(speed)
-    elif drive is not False:
-        drive_speed = float(drive)
-    times, torques = (None, None) if brake is None else (list(map(float, brake[0])), list(map(float, brake[1])))
+    drive_speed, times, torques = _drive_and_brake(drive, speed, brake)
     res = dict(
         _core.run_train(
             _table(track),
@@ -104,10 +120,7 @@ def run(
             car=car,
         )
     )
-    if "error" in res:
-        t_last = res["t"][-1] if len(res["t"]) else 0.0
-        raise SimulationError(f"vehicle run stopped at t = {t_last:.4f} s: {res['error']}", res)
-    return res
+    return _raise_on_error(res, "vehicle run")
 
 
 def design_brake_torque(
@@ -150,12 +163,7 @@ def run_fluid(
     (samples, cars, 3), ``fluid_force_tank`` (the fluid's load on each tank, tank frame), ``volume_error``
     and ``snapshots`` (``[(t, [nodes x 4 x 3 per car])]``, position then gradients per node).
     """
-    drive_speed = None
-    if drive is True:
-        drive_speed = float(speed)
-    elif drive is not False:
-        drive_speed = float(drive)
-    times, torques = (None, None) if brake is None else (list(map(float, brake[0])), list(map(float, brake[1])))
+    drive_speed, times, torques = _drive_and_brake(drive, speed, brake)
     res = dict(
         _core.run_fluid_train(
             _table(track),
@@ -180,7 +188,4 @@ def run_fluid(
             car=car,
         )
     )
-    if "error" in res:
-        t_last = res["t"][-1] if len(res["t"]) else 0.0
-        raise SimulationError(f"fluid vehicle run stopped at t = {t_last:.4f} s: {res['error']}", res)
-    return res
+    return _raise_on_error(res, "fluid vehicle run")

@@ -36,23 +36,9 @@ use rail_mbs::track::{FOOT, Track, TrackPoint};
 use rail_mbs::vehicle::{TankCarParams, TrainScenario, build_train};
 use rail_mbs::wheel_rail::{WheelPose, WheelRailContact};
 
-/// Table 1 of seed 000: distance (ft), degree of curvature, super-elevation (in); grade 0,
-/// rail cant +0.025 / −0.025 rad (right / left).
+/// Table 1 of seed 000 (the studies' definition).
 fn table1() -> Arc<Track> {
-    let rows = [
-        (0.0, 0.0, 0.0),
-        (100.0, 0.0, 0.0),
-        (300.0, 3.0, 3.0),
-        (600.0, 3.0, 3.0),
-        (800.0, 0.0, 0.0),
-        (1000.0, 0.0, 0.0),
-        (1200.0, -3.0, -3.0),
-        (1500.0, -3.0, -3.0),
-        (1700.0, 0.0, 0.0),
-        (2800.0, 0.0, 0.0),
-    ];
-    let pts = rows.iter().map(|&(d, c, e)| TrackPoint::from_us(d, c, e, 0.0, 0.025, -0.025)).collect();
-    Arc::new(Track::new(pts).expect("table 1 track"))
+    rail_mbs::vehicle::studies::table1().expect("table 1 track")
 }
 
 fn tangent() -> Arc<Track> {

@@ -158,6 +158,20 @@ fn record_dict<'py>(py: Python<'py>, r: &TrainRecord) -> PyResult<Bound<'py, PyD
     Ok(d)
 }
 
+/// Brake table and scope from the Python arguments.
+fn brake_of(times: Option<Vec<f64>>, torques: Option<Vec<f64>>, scope: &str) -> PyResult<Option<(Table, BrakeScope)>> {
+    let scope = match scope {
+        "all" => BrakeScope::AllCars,
+        "front" => BrakeScope::FrontCar,
+        other => return Err(crate::to_py(invalid("brake_scope", other, "'all' or 'front'"))),
+    };
+    match (times, torques) {
+        (Some(t), Some(m)) => Ok(Some((Table::new("brake_times/brake_torques", t, m).map_err(crate::to_py)?, scope))),
+        (None, None) => Ok(None),
+        _ => Err(crate::to_py(invalid("brake_times/brake_torques", "one missing", "both or neither"))),
+    }
+}
+
 /// Runs a train of rigid-lading tank cars on a track given as rows
 /// `(s, curvature, superelevation, grade, cant_right, cant_left)` (SI). Returns a dict
 /// of arrays; on a failed run the dict has an `error` entry and the results so far.
@@ -194,16 +208,7 @@ pub fn run_train<'py>(
     if lading_mass != 0.0 {
         params.lading = Some((lading_mass, lading_height));
     }
-    let scope = match brake_scope {
-        "all" => BrakeScope::AllCars,
-        "front" => BrakeScope::FrontCar,
-        other => return Err(crate::to_py(invalid("brake_scope", other, "'all' or 'front'"))),
-    };
-    let brake = match (brake_times, brake_torques) {
-        (Some(t), Some(m)) => Some((Table::new("brake_times/brake_torques", t, m).map_err(crate::to_py)?, scope)),
-        (None, None) => None,
-        _ => return Err(crate::to_py(invalid("brake_times/brake_torques", "one missing", "both or neither"))),
-    };
+    let brake = brake_of(brake_times, brake_torques, brake_scope)?;
     let track = Arc::new(track_from_table(track).map_err(crate::to_py)?);
     let mut sc = TrainScenario::single(params, track, station, speed, t_end);
     sc.cars = cars;
@@ -304,16 +309,7 @@ pub fn run_fluid_train<'py>(
     car: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let params = car_params(car, wheel_profile)?;
-    let scope = match brake_scope {
-        "all" => BrakeScope::AllCars,
-        "front" => BrakeScope::FrontCar,
-        other => return Err(crate::to_py(invalid("brake_scope", other, "'all' or 'front'"))),
-    };
-    let brake = match (brake_times, brake_torques) {
-        (Some(t), Some(m)) => Some((Table::new("brake_times/brake_torques", t, m).map_err(crate::to_py)?, scope)),
-        (None, None) => None,
-        _ => return Err(crate::to_py(invalid("brake_times/brake_torques", "one missing", "both or neither"))),
-    };
+    let brake = brake_of(brake_times, brake_torques, brake_scope)?;
     if !(fill > 0.05 && fill < 0.95) {
         return Err(crate::to_py(invalid("fill", fill, "(0.05, 0.95)")));
     }

@@ -42,7 +42,7 @@ pub struct Multibody {
     joints: Vec<Joint>,
     forces: Vec<Box<dyn ForceElement>>,
     wheelsets: Vec<WheelsetContact>,
-    layout: Option<Layout>,
+    layout: Option<std::sync::Arc<Layout>>,
 }
 
 #[derive(Debug, Clone)]
@@ -285,11 +285,12 @@ impl Multibody {
         (pat, Layout { blocks, joint_entries, joint_rows })
     }
 
-    fn layout(&mut self) -> &Layout {
+    /// The index layout (built once, shared cheaply with the callbacks).
+    fn layout(&mut self) -> std::sync::Arc<Layout> {
         if self.layout.is_none() {
-            self.layout = Some(self.build_layout().1);
+            self.layout = Some(std::sync::Arc::new(self.build_layout().1));
         }
-        self.layout.as_ref().expect("layout just built")
+        self.layout.clone().expect("layout just built")
     }
 
     /// Generalized forces of element `e` on the coordinates of its two bodies (14).
@@ -344,7 +345,7 @@ impl MechanicalSystem for Multibody {
     }
 
     fn mass(&mut self, q: &[f64], values: &mut [f64]) -> Result<(), SystemError> {
-        let layout = self.layout().clone();
+        let layout = self.layout();
         for (b, body) in self.bodies.iter().enumerate() {
             let m = body.mass_block(&q[7 * b..7 * b + 7]);
             let base = layout.blocks[&(b, b)];
@@ -394,7 +395,7 @@ impl MechanicalSystem for Multibody {
         dq: &mut [f64],
         dv: &mut [f64],
     ) -> Result<(), SystemError> {
-        let layout = self.layout().clone();
+        let layout = self.layout();
         let mut jq = [[0.0; 14]; 14];
         let mut jv = [[0.0; 14]; 14];
         let clear = |j: &mut [[f64; 14]; 14]| j.iter_mut().for_each(|r| r.fill(0.0));
@@ -484,7 +485,7 @@ impl MechanicalSystem for Multibody {
     }
 
     fn constraints(&mut self, t: f64, q: &[f64], out: &mut [f64]) -> Result<(), SystemError> {
-        let layout = self.layout().clone();
+        let layout = self.layout();
         let zeros = vec![0.0; q.len()];
         for b in 0..self.bodies.len() {
             let p = &q[7 * b + 3..7 * b + 7];
@@ -499,7 +500,7 @@ impl MechanicalSystem for Multibody {
     }
 
     fn constraint_jacobian(&mut self, t: f64, q: &[f64], values: &mut [f64]) -> Result<(), SystemError> {
-        let layout = self.layout().clone();
+        let layout = self.layout();
         let zeros = vec![0.0; q.len()];
         for b in 0..self.bodies.len() {
             for k in 0..4 {
@@ -532,7 +533,7 @@ impl MechanicalSystem for Multibody {
         lambda: &[f64],
         dq: &mut [f64],
     ) -> Result<bool, SystemError> {
-        let layout = self.layout().clone();
+        let layout = self.layout();
         let zeros = vec![0.0; q.len()];
         // Normalization: ∂(2 p λ)/∂p = 2 λ I.
         for (b, lam) in lambda.iter().enumerate().take(self.bodies.len()) {

@@ -426,7 +426,7 @@ use ancf_core::mesh::{CylinderTankSpec, cylinder_tank, cylinder_tank_compartment
 use ancf_core::tank::{Bulkhead, TankGeometry, TankShape};
 use std::time::Instant;
 
-use super::run::{TrainRecord, TrainScenario, build_train, record_sample};
+use super::run::{TrainRecord, TrainScenario, build_train, record_sample, step_and_record};
 use super::tank_car::CarBodies;
 use crate::integrator::{Hht, IntegratorError};
 
@@ -571,29 +571,10 @@ pub fn run_fluid_train(
         Err(error) => return Ok(Err(Box::new(FluidTrainFailure { error, record: finish(None, rec) }))),
     };
     let mut hints: Vec<f64> = cars.iter().flat_map(|c| [c.station; 4]).collect();
-    let n_rec = (sc.t_end / sc.record_every).round() as usize;
-    for k in 0..=n_rec {
-        let target = (k as f64 * sc.record_every).min(sc.t_end);
-        while hht.t() < target - 1e-12 {
-            let h = sc.step.min(target - hht.t());
-            if let Err(error) = hht.step(h) {
-                return Ok(Err(Box::new(FluidTrainFailure { error, record: finish(Some(&hht), rec) })));
-            }
-        }
+    let result = step_and_record(&mut hht, sc, |hht, k| {
         let (t, q, v) = (hht.t(), hht.q().to_vec(), hht.v().to_vec());
         let sys = hht.system_mut();
-        let res = record_sample(
-            &mut sys.mb,
-            (t, &q[..nr], &v[..nr]),
-            &sc.track,
-            &cars,
-            &couplers,
-            &mut hints,
-            &mut rec.train,
-        );
-        if let Err(error) = res {
-            return Ok(Err(Box::new(FluidTrainFailure { error, record: finish(Some(&hht), rec) })));
-        }
+        record_sample(&mut sys.mb, (t, &q[..nr], &v[..nr]), &sc.track, &cars, &couplers, &mut hints, &mut rec.train)?;
         record_fluid(hht.system(), &q, &v, &mut rec);
         if sc.snapshot_every > 0.0 {
             let every = (sc.snapshot_every / sc.record_every).round().max(1.0) as usize;
@@ -603,6 +584,10 @@ pub fn run_fluid_train(
                 rec.snapshots.push((t, e));
             }
         }
+        Ok(())
+    });
+    if let Err(error) = result {
+        return Ok(Err(Box::new(FluidTrainFailure { error, record: finish(Some(&hht), rec) })));
     }
     Ok(Ok(finish(Some(&hht), rec)))
 }

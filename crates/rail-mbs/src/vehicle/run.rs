@@ -280,6 +280,24 @@ pub(crate) fn record_sample(
     Ok(())
 }
 
+/// Steps `hht` to every recording time of `sc` (0, `record_every`, … `t_end`), calling
+/// `record(hht, k)` at sample `k`; stops at the first error.
+pub(crate) fn step_and_record<S: crate::integrator::MechanicalSystem>(
+    hht: &mut Hht<S>,
+    sc: &TrainScenario,
+    mut record: impl FnMut(&mut Hht<S>, usize) -> Result<(), IntegratorError>,
+) -> Result<(), IntegratorError> {
+    let n_rec = (sc.t_end / sc.record_every).round() as usize;
+    for k in 0..=n_rec {
+        let target = (k as f64 * sc.record_every).min(sc.t_end);
+        while hht.t() < target - 1e-12 {
+            hht.step(sc.step.min(target - hht.t()))?;
+        }
+        record(hht, k)?;
+    }
+    Ok(())
+}
+
 /// Runs a scenario; on failure returns what was recorded so far with the error.
 pub fn run_train(sc: &TrainScenario) -> Result<Result<TrainRecord, Box<TrainFailure>>, AncfError> {
     let (mb, cars, couplers) = build_train(sc)?;
@@ -302,21 +320,12 @@ pub fn run_train(sc: &TrainScenario) -> Result<Result<TrainRecord, Box<TrainFail
         Err(error) => return Ok(Err(Box::new(TrainFailure { error, record: finish(None, rec) }))),
     };
     let mut hints: Vec<f64> = cars.iter().flat_map(|c| [c.station; 4]).collect();
-    let n_rec = (sc.t_end / sc.record_every).round() as usize;
-    for k in 0..=n_rec {
-        let target = (k as f64 * sc.record_every).min(sc.t_end);
-        while hht.t() < target - 1e-12 {
-            let h = sc.step.min(target - hht.t());
-            if let Err(error) = hht.step(h) {
-                return Ok(Err(Box::new(TrainFailure { error, record: finish(Some(&hht), rec) })));
-            }
-        }
+    let result = step_and_record(&mut hht, sc, |hht, _| {
         let (t, q, v) = (hht.t(), hht.q().to_vec(), hht.v().to_vec());
-        if let Err(error) =
-            record_sample(hht.system_mut(), (t, &q, &v), &sc.track, &cars, &couplers, &mut hints, &mut rec)
-        {
-            return Ok(Err(Box::new(TrainFailure { error, record: finish(Some(&hht), rec) })));
-        }
+        record_sample(hht.system_mut(), (t, &q, &v), &sc.track, &cars, &couplers, &mut hints, &mut rec)
+    });
+    if let Err(error) = result {
+        return Ok(Err(Box::new(TrainFailure { error, record: finish(Some(&hht), rec) })));
     }
     Ok(Ok(finish(Some(&hht), rec)))
 }

@@ -1,0 +1,41 @@
+//! One braking run of the crude-oil studies with its wall time and Newton statistics:
+//! `cargo run --release -p rail-mbs --example ecp_braking -- [light|medium|heavy|water] [nx ny nz] [t_end] [ecp|conventional] [bulkheads]`
+use rail_mbs::vehicle::BrakeScope;
+use rail_mbs::vehicle::studies::{BrakingCase, Oil, SETTLE, run_braking};
+
+fn main() {
+    let a: Vec<String> = std::env::args().skip(1).collect();
+    let oil = match a.first().map_or("light", |s| s.as_str()) {
+        "medium" => Oil::Medium,
+        "heavy" => Oil::Heavy,
+        "water" => Oil::Water,
+        _ => Oil::Light,
+    };
+    let n = |i: usize, d: usize| a.get(i).map_or(d, |s| s.parse().unwrap());
+    let counts = [n(1, 6), n(2, 4), n(3, 2)];
+    let t_end: f64 = a.get(4).map_or(SETTLE + 10.0, |s| s.parse().unwrap());
+    let scope =
+        if a.get(5).map(|s| s.as_str()) == Some("conventional") { BrakeScope::FrontCar } else { BrakeScope::AllCars };
+    let bulkheads = a.get(6).map(|s| s.as_str()) == Some("bulkheads");
+    let case = BrakingCase { oil, cars: 2, scope, bulkheads, counts, t_end, rear_brake_factor: 1.0 };
+    let r = run_braking(&case).expect("run");
+    let s = &r.train;
+    let peak = s.coupler_force.iter().map(|c| c[0].abs()).fold(0.0, f64::max);
+    println!(
+        "{} crude, {:?}, {} elements/tank, {:.1} s simulated: wall {:.1} s ({:.3} sim s per wall s), steps {} (rejected {}), Newton {} ({:.2}/step), Jacobians {}, peak |coupler| {:.0} N, final speed {:.2} km/h, max |volume error| {:.2e}",
+        oil.name(),
+        scope,
+        r.elements,
+        t_end,
+        s.wall_time,
+        t_end / s.wall_time,
+        s.steps,
+        s.rejected_steps,
+        s.newton_iterations,
+        s.newton_iterations as f64 / s.steps as f64,
+        s.jacobian_evaluations,
+        peak,
+        s.tank_speed.last().map_or(f64::NAN, |v| v[0] * 3.6),
+        r.volume_error.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()))
+    );
+}
