@@ -56,8 +56,8 @@ _DESCRIPTIONS = {
     "volume conserved, centroid height",
     "slosh-rect-tank": "seed 003 rectangular tank (0.416 x 0.324 m, 0.132 m water), 0.3 g lateral pulse: "
     "first-mode frequency vs analytic 1.436 Hz",
-    "slosh-cylinder-half": "half-full horizontal cylinder: transverse mode lambda vs 1.3557 (full form), "
-    "longitudinal mode vs the rectangular-tank formula",
+    "slosh-cylinder-half": "half-full horizontal cylinder: stable rest state, transverse mode lambda vs 1.3557 "
+    "(linear modes; full form also the pulse response), longitudinal mode vs the rectangular-tank formula",
     "slosh-viscous-decay": "free sloshing decays faster from water through the crude oils of seed 000 Table 2; "
     "heavy crude settles within one period",
     "bulkhead-longitudinal": "three-compartment tank car has a lower peak longitudinal load than the open tank "

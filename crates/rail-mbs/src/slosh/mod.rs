@@ -2,12 +2,15 @@
 //! the recorded outputs.
 //!
 //! Data flow: [`SloshSystem`] (fluid body + wall contact + motion) → [`SloshRun`] (HHT
-//! integrator loop) → [`SloshRecord`] (time series, recorded every step).
+//! integrator loop) → [`SloshRecord`] (time series, recorded every step); [`modes`] gives the
+//! small-amplitude modes of a [`SloshSystem`] about a state at rest.
 
+pub mod modes;
 pub mod motion;
 pub mod system;
 pub mod validate;
 
+pub use modes::{LinearModes, linear_modes};
 pub use motion::{PiecewiseAcceleration, PrescribedMotion, TankState};
 pub use system::{SloshFrame, SloshSystem};
 
