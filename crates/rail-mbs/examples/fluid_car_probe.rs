@@ -35,7 +35,12 @@ fn main() {
     let k = 1000.0 * rho * g * depth;
     let mut fluid = Fluid::new(rho, rheology, k).unwrap();
     fluid.bulk_damping = 0.2 * (k * rho).sqrt() * (1.5 / n[2] as f64);
-    let cargo = FluidCargo { fluid, counts: n, fill: 0.5, bulkheads: vec![], quadrature: QuadratureOptions::default() };
+    let mut cargo = FluidCargo::new(fluid, n, 0.5, vec![]);
+    if std::env::var("DEFAULT_DISC").is_ok() {
+        cargo.quadrature = QuadratureOptions::default();
+        cargo.wall_stiffness_factor = 1.0;
+        cargo.contact_points_per_edge = 3;
+    }
     let track = Arc::new(
         Track::new(vec![
             TrackPoint::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0),

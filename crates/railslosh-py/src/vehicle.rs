@@ -318,13 +318,7 @@ pub fn run_fluid_train<'py>(
         Some(f) => f.get().inner,
         None => oil_of(oil)?.fluid(depth, depth / counts.2.max(1) as f64).map_err(crate::to_py)?,
     };
-    let cargo = FluidCargo {
-        fluid,
-        counts: [counts.0, counts.1, counts.2],
-        fill,
-        bulkheads: bulkheads.unwrap_or_default(),
-        quadrature: ancf_core::element::QuadratureOptions::default(),
-    };
+    let cargo = FluidCargo::new(fluid, [counts.0, counts.1, counts.2], fill, bulkheads.unwrap_or_default());
     let track = Arc::new(track_from_table(track).map_err(crate::to_py)?);
     let mut sc = TrainScenario::single(params, track, station, speed, t_end);
     sc.cars = cars;

@@ -138,13 +138,8 @@ fn cargo(oil: Oil, counts: [usize; 3], bulkheads: bool, p: &TankCarParams) -> Re
     let depth = p.tank_radius;
     let fluid = oil.fluid(depth, depth / counts[2] as f64)?;
     let third = (p.tank_length - 1.0) / 6.0;
-    Ok(FluidCargo {
-        fluid,
-        counts,
-        fill: 0.5,
-        bulkheads: if bulkheads { vec![(-third, 0.02), (third, 0.02)] } else { vec![] },
-        quadrature: QuadratureOptions::default(),
-    })
+    let bulkheads = if bulkheads { vec![(-third, 0.02), (third, 0.02)] } else { vec![] };
+    Ok(FluidCargo::new(fluid, counts, 0.5, bulkheads))
 }
 
 fn finish(
