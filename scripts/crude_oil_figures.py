@@ -24,6 +24,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 from railslosh import rail, vehicle
+from railslosh.slosh import SimulationError
 
 OILS = ("light", "medium", "heavy")
 
@@ -67,6 +68,8 @@ def outward_inertia(res: dict, track: rail.Track, t_avg: float) -> tuple[float, 
     a = (x[2:] - 2 * x[1:-1] + x[:-2]) / h**2
     s = res["tank_station"][1:-1, 0]
     keep = t[1:-1] >= t[-1] - t_avg
+    if len(t) < 3 or not keep.any():
+        return float("nan"), float("nan")
     fc, gc = [], []
     for ak, sk in zip(a[keep], s[keep], strict=True):
         _, axes = track.frame(sk)
@@ -102,11 +105,21 @@ def main() -> None:
     kwargs["ecp_light_bulkheads"] = {"bulkheads": [(-third, 0.02), (third, 0.02)]}
     for m in meshes:
         kwargs[f"mesh_{m[0]}x{m[1]}x{m[2]}"] = {"cars": 1}
+
+    def guarded(f, *args, **kw):
+        # A run that stops early keeps what it computed; the failure is reported and plotted as far as it got.
+        try:
+            return f(*args, **kw)
+        except SimulationError as exc:
+            print(f"run stopped: {exc}")
+            return exc.results
+
     with ThreadPoolExecutor(max_workers=a.workers) as pool:
-        futures = {k: pool.submit(f, *args, **kwargs[k]) for k, (f, args) in jobs.items()}
+        futures = {k: pool.submit(guarded, f, *args, **kwargs[k]) for k, (f, args) in jobs.items()}
         res = {k: f.result() for k, f in futures.items()}
         for k, r in res.items():
-            print(f"{k}: {r['stats']['wall_time']:.0f} s wall, {r['stats']['steps']} steps")
+            stop = f", STOPPED at t = {r['t'][-1]:.2f} s" if "error" in r else ""
+            print(f"{k}: {r['stats']['wall_time']:.0f} s wall, {r['stats']['steps']} steps{stop}")
     np.savez_compressed(
         out / "crude_oil_studies.npz",
         **{f"{k}__{f}": np.asarray(v[f]) for k, v in res.items() for f in ("t", "coupler_force", "oil_com_tank")},
