@@ -62,6 +62,36 @@ fn sys_err(e: AncfError) -> SystemError {
     }
 }
 
+/// Subtracts every element's exact Jacobians `∂f/∂e`, `∂f/∂ė` (internal forces enter
+/// `Q` with a minus sign) from pattern values laid out in 12×12 node-pair blocks, whose
+/// starts per element are `element_blocks` (as built by [`SloshSystem::new`]).
+pub(crate) fn subtract_element_jacobians(
+    body: &FluidBody,
+    element_blocks: &[[usize; 64]],
+    e: &[f64],
+    edot: &[f64],
+    dq: &mut [f64],
+    dv: &mut [f64],
+) -> Result<(), SystemError> {
+    let jacs = body.element_jacobians(e, edot).map_err(sys_err)?;
+    for (el, jac) in jacs.iter().enumerate() {
+        let eb = &element_blocks[el];
+        for a in 0..N_SHAPE {
+            for b in 0..N_SHAPE {
+                for i in 0..3 {
+                    let row = 96 * (3 * a + i);
+                    for k in 0..3 {
+                        let idx = SloshSystem::element_index(eb, a, i, b, k);
+                        dq[idx] -= jac.stiffness[row + 3 * b + k];
+                        dv[idx] -= jac.damping[row + 3 * b + k];
+                    }
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
 impl SloshSystem {
     /// Assemble the system and its fixed sparsity pattern (12×12 blocks for every pair of
     /// nodes that share an element).
@@ -159,7 +189,7 @@ impl SloshSystem {
     /// Pattern index of entry (compact 3a + i, compact 3b + k) of an element whose node-pair
     /// blocks start at `eb`.
     #[inline]
-    fn element_index(eb: &[usize; 64], a: usize, i: usize, b: usize, k: usize) -> usize {
+    pub(crate) fn element_index(eb: &[usize; 64], a: usize, i: usize, b: usize, k: usize) -> usize {
         eb[8 * (a / 4) + b / 4] + (3 * (a % 4) + i) * 12 + 3 * (b % 4) + k
     }
 
@@ -243,22 +273,7 @@ impl MechanicalSystem for SloshSystem {
         dq: &mut [f64],
         dv: &mut [f64],
     ) -> Result<(), SystemError> {
-        let jacs = self.body.element_jacobians(q, v).map_err(sys_err)?;
-        for (el, jac) in jacs.iter().enumerate() {
-            let eb = &self.element_blocks[el];
-            for a in 0..N_SHAPE {
-                for b in 0..N_SHAPE {
-                    for i in 0..3 {
-                        let row = 96 * (3 * a + i);
-                        for k in 0..3 {
-                            let idx = Self::element_index(eb, a, i, b, k);
-                            dq[idx] -= jac.stiffness[row + 3 * b + k];
-                            dv[idx] -= jac.damping[row + 3 * b + k];
-                        }
-                    }
-                }
-            }
-        }
+        subtract_element_jacobians(&self.body, &self.element_blocks, q, v, dq, dv)?;
         if let Some((b, wc)) = self.rotation_terms(t) {
             let m = self.body.scalar_mass().as_ref();
             for j in 0..m.ncols() {

@@ -289,26 +289,9 @@ impl MechanicalSystem for FluidVehicle {
             let f = &self.fluids[k];
             let n = f.body.n_coords();
             let (e, ed) = (&q[lay.offset..lay.offset + n], &v[lay.offset..lay.offset + n]);
-            let idx = |eb: &[usize; 64], a: usize, i: usize, b: usize, c: usize| {
-                eb[8 * (a / 4) + b / 4] + (3 * (a % 4) + i) * 12 + 3 * (b % 4) + c
-            };
+            let idx = crate::slosh::system::SloshSystem::element_index;
             // Fluid–fluid: element Jacobians.
-            let jacs = f.body.element_jacobians(e, ed).map_err(sys_err)?;
-            for (el, jac) in jacs.iter().enumerate() {
-                let eb = &lay.element_blocks[el];
-                for a in 0..N_SHAPE {
-                    for b in 0..N_SHAPE {
-                        for i in 0..3 {
-                            let row = 96 * (3 * a + i);
-                            for c in 0..3 {
-                                let x = idx(eb, a, i, b, c);
-                                dq[x] -= jac.stiffness[row + 3 * b + c];
-                                dv[x] -= jac.damping[row + 3 * b + c];
-                            }
-                        }
-                    }
-                }
-            }
+            crate::slosh::system::subtract_element_jacobians(&f.body, &lay.element_blocks, e, ed, dq, dv)?;
             // Contact: fluid–fluid point Jacobians and the exact tank rows.
             let tank = self.mb.state(Some(f.tank), &q[..nr], &v[..nr]);
             let mut scratch = vec![0.0; n];
