@@ -27,7 +27,7 @@
 //!
 //! # Placement
 //!
-//! A car is placed on a [`Track`] with its tank centre at arc length `s`: every body
+//! A car is placed on a [`Track`](crate::track::Track) with its tank centre at arc length `s`: every body
 //! sits at its own station, in the local track frame (tangent, left, up, banked by the
 //! super-elevation), and moves initially with the speed `V` along the tangent, the yaw
 //! rate `V κ`, and — wheelsets — the rolling spin `V / r₀`. The front of the car (bogie

@@ -21,7 +21,7 @@
 //! coefficient `d` in s/m, clamped at zero), with `K_h` and the ellipse semi-axes from the
 //! relative principal curvatures ([`hertz`]). Tangential force: creepages from the rigid
 //! body velocities and a creep law ([`creep`]; Shen–Hedrick–Elkins by default, Polach
-//! optional; FASTSIM is not implemented — TODO).
+//! and FASTSIM with three flexibilities optional).
 //!
 //! # Search strategy and limits
 //!
