@@ -31,6 +31,22 @@ pub struct Record {
     pub passed: bool,
 }
 
+/// One line: case, quantity, measured, reference, tolerance and verdict.
+impl std::fmt::Display for Record {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} {}: measured {:.6} reference {:.6} tol {:.3e} -> {}",
+            self.case,
+            self.quantity,
+            self.measured,
+            self.reference,
+            self.tolerance,
+            if self.passed { "ok" } else { "FAIL" }
+        )
+    }
+}
+
 impl Record {
     /// Check |measured − reference| ≤ tolerance.
     pub fn abs(case: &str, quantity: impl Into<String>, measured: f64, reference: f64, tolerance: f64) -> Self {

@@ -13,15 +13,7 @@ fn main() {
     match result {
         Ok(recs) => {
             for r in recs {
-                println!(
-                    "{} {}: measured {:.6} reference {:.6} tol {:.3e} -> {}",
-                    r.case,
-                    r.quantity,
-                    r.measured,
-                    r.reference,
-                    r.tolerance,
-                    if r.passed { "ok" } else { "FAIL" }
-                );
+                println!("{r}");
             }
         }
         Err(e) => println!("error: {e}"),
