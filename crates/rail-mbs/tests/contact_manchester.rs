@@ -13,11 +13,7 @@
 use std::path::PathBuf;
 
 use nalgebra::{Matrix3, Vector3};
-use rail_mbs::profile::{Profile, read_simpack};
-use rail_mbs::track::Side;
-use rail_mbs::wheel_rail::{
-    ContactPoint, CreepModel, Material, RailGeometry, RailPath, WheelGeometry, WheelPose, WheelRailContact,
-};
+use rail_mbs::wheel_rail::{ContactPoint, CreepModel, WheelPose, WheelRailContact};
 
 fn data_dir() -> Option<PathBuf> {
     let p = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/manchester-contact"));
@@ -91,36 +87,9 @@ fn parse_ref(text: &str) -> Vec<RefCase> {
     cases
 }
 
-struct Setup {
-    contact: WheelRailContact,
-}
-
-fn setup(dir: &std::path::Path, model: CreepModel) -> Setup {
-    let rail_file = read_simpack(dir.join("MBench_UIC60_v3.prr")).expect("rail profile");
-    let wheel_file = read_simpack(dir.join("MBench_S1002_v3.prw")).expect("wheel profile");
-    let rail_full = rail_file.to_profile().expect("rail spline");
-    // Gauge point 14 mm below the crown, on the full (untrimmed) profile.
-    let offset = RailGeometry::offset_for_gauge(&rail_full, 1.435, 0.014).expect("gauge point");
-    // The near-vertical canted side faces cannot be followed by a z(y) spline.
-    let rail = rail_full.trim_steep_ends(10.0).expect("trimmed rail");
-    let wheel: Profile = wheel_file.to_profile().expect("wheel spline");
-    println!("rail profile offset {:.4} mm", offset * 1000.0);
-    let wheel_geo =
-        WheelGeometry { profile: wheel, nominal_radius: 0.460, profile_offset: 0.680 + 0.070, side: Side::Left };
-    let rail_geo = RailGeometry {
-        profile: rail,
-        side: Side::Left,
-        profile_offset: offset,
-        vertical_offset: 0.0,
-        path: RailPath::Straight { inward_cant: 0.0 },
-    };
-    let mut contact = WheelRailContact::new(wheel_geo, rail_geo);
-    let mat = Material::from_shear(82e9, 0.28);
-    contact.wheel_material = mat;
-    contact.rail_material = mat;
-    contact.friction = 0.3;
-    contact.creep_model = model;
-    Setup { contact }
+/// The contact pair of the benchmark (the validation case's own construction).
+fn setup(dir: &std::path::Path, model: CreepModel) -> WheelRailContact {
+    rail_mbs::wheel_rail::validate::manchester_contact_pair(dir, model).expect("Manchester contact pair")
 }
 
 fn rot_z(a: f64) -> Matrix3<f64> {
@@ -192,7 +161,7 @@ fn run(model: CreepModel, label: &str) -> Option<Vec<Row>> {
     let text = std::fs::read_to_string(dir.join("mbench_a22_left.ref_out")).expect("ref_out");
     let cases = parse_ref(&text);
     assert_eq!(cases.len(), 21, "expected 21 cases in the reference output");
-    let mut s = setup(&dir, model);
+    let mut contact = setup(&dir, model);
     println!("Manchester A-2.2 left wheel, creep law {label}");
     println!(
         "{:>5} {:>4} | {:>9} {:>9} {:>6} | {:>8} {:>8} {:>6} | {:>8} {:>8} {:>6} | {:>8} {:>8} {:>6}",
@@ -200,7 +169,7 @@ fn run(model: CreepModel, label: &str) -> Option<Vec<Row>> {
     );
     let mut out = Vec::new();
     for c in cases.iter() {
-        let (_z, pts) = solve_case(&mut s.contact, c, c.fz_total);
+        let (_z, pts) = solve_case(&mut contact, c, c.fz_total);
         let n_ours = pts.len();
         // Report the most loaded contact.
         let p = pts.iter().max_by(|a, b| a.normal_force.total_cmp(&b.normal_force)).expect("at least one contact");
@@ -313,9 +282,9 @@ fn manchester_load_balance() {
     };
     let text = std::fs::read_to_string(dir.join("mbench_a22_left.ref_out")).expect("ref_out");
     let cases = parse_ref(&text);
-    let mut s = setup(&dir, CreepModel::ShenHedrickElkins);
+    let mut contact = setup(&dir, CreepModel::ShenHedrickElkins);
     for c in cases.iter().step_by(4) {
-        let (_z, pts) = solve_case(&mut s.contact, c, 10_000.0);
+        let (_z, pts) = solve_case(&mut contact, c, 10_000.0);
         let fz: f64 = pts.iter().map(|p| p.force_on_wheel().z).sum();
         assert!((fz - 10_000.0).abs() < 1e-3, "vertical force {fz} N");
         for p in &pts {
