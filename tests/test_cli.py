@@ -1,6 +1,7 @@
 """The command-line tool as a user runs it."""
 
 import json
+import re
 import subprocess
 import sys
 
@@ -72,3 +73,74 @@ def test_demo_runs_and_reports(oil):
     assert "1260 coordinates" in out.stdout
     assert "peak longitudinal load" in out.stdout
     assert "0 failed" in out.stdout
+
+
+# --- run / plot / report / sweep (issue 9) -----------------------------------------------------
+
+EXAMPLES = __import__("pathlib").Path(__file__).resolve().parents[1] / "examples" / "scenes"
+
+
+def test_run_plot_report_as_a_user_does(tmp_path):
+    out = tmp_path / "ecp"
+    r = run_cli("run", str(EXAMPLES / "two_car_ecp_braking_rigid.toml"), "-o", str(out), "--t-end", "0.05")
+    assert r.returncode == 0, r.stderr
+    assert "100.0% t = 0.050/0.05 s" in r.stderr and "ETA" in r.stderr and "Newton" in r.stderr
+    for f in ("results.nc", "run.json", "plots/coupler_force.png"):
+        assert (out / f).is_file(), f
+    summary = json.loads((out / "run.json").read_text())
+    assert summary["t_reached"] == 0.05 and summary["stats"]["steps"] > 0 and summary["error"] is None
+    # plot and report in-process (the same entry point as the command; saves two interpreter starts)
+    assert cli.main(["plot", str(out / "results.nc"), "-o", str(tmp_path / "p")]) == 0
+    assert (tmp_path / "p" / "wheel_loads.png").is_file()
+    assert cli.main(["report", str(out)]) == 0 and (out / "report.html").is_file()
+
+
+def test_run_set_overrides_and_errors(tmp_path, capsys):
+    scene_file = str(EXAMPLES / "two_car_ecp_braking_rigid.toml")
+    r = run_cli("run", scene_file, "-o", str(tmp_path), "--set", "train.speed_kmh=500", "-q")
+    assert r.returncode == 2 and "invalid parameter `train.speed_kmh` = 500" in r.stderr
+
+    def status(*args):
+        code = cli.main(list(args))
+        return code, capsys.readouterr().err
+
+    code, err = status("run", scene_file, "--set", "speed=5")
+    assert code == 2 and "invalid parameter `--set`" in err
+    code, err = status("run", str(tmp_path / "missing.toml"))
+    assert code == 2 and "missing.toml" in err
+    code, err = status("plot", str(tmp_path / "none.nc"))
+    assert code == 2 and "invalid parameter `results`" in err
+
+
+def test_progress_bar_line_shows_time_eta_and_newton_statistics():
+    import io
+
+    bar = cli.ProgressBar(stream=io.StringIO(), every=0.0)
+    bar.start -= 10.0  # 10 s of wall time so far
+    line = bar.line(2.5, 10.0, 200, 900, 7)
+    assert "25.0%" in line and "t = 2.500/10 s" in line and "200 steps (7 rejected)" in line
+    assert "Newton 4.50/step" in line
+    eta = float(re.search(r"ETA\s+([0-9.]+) s", line).group(1))
+    assert eta == pytest.approx(30.0, rel=0.01)  # 10 s for the first quarter: 30 s to go
+    bar(10.0, 10.0, 400, 1800, 7)
+    assert bar.stream.getvalue().strip().startswith("[########################] 100.0%")
+
+
+def test_sweep_command_writes_one_dataset(tmp_path):
+    r = run_cli(
+        "sweep",
+        str(EXAMPLES / "two_car_ecp_braking_rigid.toml"),
+        "--grid",
+        "braking=ecp,conventional",
+        "--set",
+        "train.t_end=0.03",
+        "--workers",
+        "2",
+        "-o",
+        str(tmp_path),
+    )
+    assert r.returncode == 0, r.stderr
+    from railslosh import results
+
+    ds = results.load(tmp_path / "sweep.nc")
+    assert ds.sizes["braking"] == 2 and "2/2 runs done" in r.stderr

@@ -35,7 +35,10 @@ def test_there_are_example_scenes():
     assert {"two_car_ecp_braking_rigid.toml", "single_car_table1_curve_60kmh.toml"} <= names
 
 
-@pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.stem)
+RIGID_EXAMPLES = [p for p in EXAMPLES if scene.load_scene(p).kind == "vehicle"]
+
+
+@pytest.mark.parametrize("path", RIGID_EXAMPLES, ids=lambda p: p.stem)
 def test_example_scene_loads_and_runs_short(path):
     full = scene.load_scene(path)
     assert full.t_end <= 2.0, "example scenes are kept short"
@@ -255,3 +258,246 @@ def test_fuzz_one_field_of_a_valid_scene(section, key, value):
     doc = copy.deepcopy(BASE)
     doc[section][key] = value
     _check(doc)
+
+
+# --- liquid cargo and prescribed-motion scenes (issue 9) ----------------------------------------
+
+PAPER_SCENARIOS = {
+    # seed 000 §8: ECP braking light/medium/heavy, conventional braking, bulkheads, curves 60/100 km/h
+    "crude_ecp_braking_light": ("fluid_vehicle", {"oil": "light", "scope": "all", "bulkheads": 0}),
+    "crude_ecp_braking_medium": ("fluid_vehicle", {"oil": "medium", "scope": "all", "bulkheads": 0}),
+    "crude_ecp_braking_heavy": ("fluid_vehicle", {"oil": "heavy", "scope": "all", "bulkheads": 0}),
+    "crude_conventional_braking_light": ("fluid_vehicle", {"oil": "light", "scope": "front", "bulkheads": 0}),
+    "crude_conventional_braking_heavy": ("fluid_vehicle", {"oil": "heavy", "scope": "front", "bulkheads": 0}),
+    "crude_ecp_braking_light_bulkheads": ("fluid_vehicle", {"oil": "light", "scope": "all", "bulkheads": 2}),
+    "crude_curve_60kmh": ("fluid_vehicle", {"speed_kmh": 60.0}),
+    "crude_curve_100kmh": ("fluid_vehicle", {"speed_kmh": 100.0}),
+    # seed 003 §3: the six Phase 1 maneuvers
+    "swri_lane_change_20mph": ("slosh", {"type": "lane_change", "mph": 20.0}),
+    "swri_lane_change_40mph": ("slosh", {"type": "lane_change", "mph": 40.0}),
+    "swri_bump_half_round_9in_10mph": ("slosh", {"type": "bump", "shape": "half_round", "in": 9.0, "mph": 10.0}),
+    "swri_bump_half_round_12in_5mph": ("slosh", {"type": "bump", "shape": "half_round", "in": 12.0, "mph": 5.0}),
+    "swri_bump_trapezoid_9in_15mph": ("slosh", {"type": "bump", "shape": "trapezoid", "in": 9.0, "mph": 15.0}),
+    "swri_bump_trapezoid_12in_10mph": ("slosh", {"type": "bump", "shape": "trapezoid", "in": 12.0, "mph": 10.0}),
+}
+
+
+@pytest.mark.parametrize("stem", sorted(PAPER_SCENARIOS))
+def test_every_paper_scenario_has_an_example_with_its_parameters(stem):
+    kind, want = PAPER_SCENARIOS[stem]
+    sc = scene.load_scene(ROOT / "examples" / "scenes" / f"{stem}.toml")
+    assert sc.kind == kind and sc.name
+    if kind == "fluid_vehicle":
+        assert sc.fluid.fill == 0.5 and sc.fluid.counts[0] * sc.fluid.counts[1] * sc.fluid.counts[2] <= 12
+        if "oil" in want:
+            assert sc.fluid.oil == want["oil"] and sc.brake_scope == want["scope"]
+            assert len(sc.fluid.bulkheads) == want["bulkheads"]
+            assert sc.cars == 2 and sc.speed == pytest.approx(40 / 3.6) and sc.t_end == pytest.approx(10.5)
+            # designed brake: the torque table rises from 0 after the 0.5 s settling time
+            assert sc.brake_torques[0] == 0.0 and max(sc.brake_torques) > 1e3 and sc.brake_times[1] >= 0.5
+        else:
+            assert sc.speed == pytest.approx(want["speed_kmh"] / 3.6) and sc.drive is True
+            assert sc.track_source == "preset:table1"
+    else:
+        m = sc.maneuver
+        assert m["type"] == want["type"] and m["speed"] == pytest.approx(want["mph"] * scene.MPH)
+        assert sc.tank.shape == "elliptic" and sc.fluid.oil == "water"
+        if want["type"] == "bump":
+            assert m["shape"] == want["shape"] and m["height"] == pytest.approx(want["in"] * scene.INCH)
+
+
+def test_fluid_scene_kwargs_and_designed_brake_matches_the_vehicle_function():
+    sc = scene.load_scene(ROOT / "examples/scenes/crude_ecp_braking_light_bulkheads.toml")
+    kw = sc.fluid_kwargs()
+    assert kw["oil"] == "light" and kw["fill"] == 0.5 and kw["counts"] == (3, 2, 2)
+    assert kw["bulkheads"] == [(-1.8333, 0.02), (1.8333, 0.02)] and kw["snapshot_every"] == 0.5
+    assert "lading_mass" not in kw
+    # the designed brake equals design_brake_torque for car + liquid mass
+    car = railslosh.vehicle.tank_car_parameters()["total_mass"]
+    liquid = 850.0 * railslosh.mesh.cylinder_tank(length=11.0, fill=0.5, n_length=2, n_width=2).exact_volume
+    times, torques = railslosh.vehicle.design_brake_torque(car + liquid, 40 / 3.6, 5 / 3.6, 10.0)
+    assert sc.brake_times == pytest.approx(times) and sc.brake_torques == pytest.approx(torques)
+    # round trip through to_dict keeps the scene
+    again = scene.load_scene(sc.to_dict())
+    assert again.fluid == sc.fluid and again.brake_torques == pytest.approx(sc.brake_torques)
+
+
+FLUID_BASE = {
+    "track": {"preset": "tangent", "length": 4000.0},
+    "train": {"cars": 1, "station": 300.0, "speed_kmh": 40.0, "t_end": 0.5, "step": 4e-3, "record_every": 0.02},
+    "fluid": {"oil": "light", "fill": 0.5},
+    "mesh": {"counts": [2, 2, 2]},
+}
+
+SLOSH_BASE = {
+    "tank": {"shape": "elliptic"},
+    "fluid": {"oil": "water", "fill": 0.5},
+    "mesh": {"counts": [1, 2, 2]},
+    "solver": {"t_end": 1.0, "step": 0.01},
+    "maneuver": {"type": "lane_change", "speed_mph": 20.0},
+}
+
+BAD_NEW = [
+    (FLUID_BASE, "fluid.oil", "diesel", "fluid.oil"),
+    (FLUID_BASE, "fluid.fill", 0.97, "fluid.fill"),
+    (FLUID_BASE, "fluid.density", 900.0, "fluid.density"),  # only with oil = "custom"
+    (FLUID_BASE, "mesh.counts", [2, 2], "mesh.counts"),
+    (FLUID_BASE, "mesh.counts", [2, 1, 2], "mesh.counts[1]"),
+    (FLUID_BASE, "tank.bulkheads", [[0.0, 0.02], [0.0, 0.02]], "tank.bulkheads[1][0] (x)"),
+    (FLUID_BASE, "tank.bulkheads", [[6.0, 0.02]], "tank.bulkheads[0][0] (x)"),
+    (FLUID_BASE, "tank.bulkheads", [[-2.0, 0.02], [2.0, 0.02]], "mesh.counts[0]"),  # 3 compartments, 2 elements
+    (FLUID_BASE, "lading.mass", 1000.0, "lading.mass"),
+    (FLUID_BASE, "outputs.snapshot_every", 0.001, "outputs.snapshot_every"),
+    (FLUID_BASE, "outputs.vtu", "yes", "outputs.vtu"),
+    (FLUID_BASE, "brake.design", 1, "brake.design"),
+    (FLUID_BASE, "brake.factors", [1.0, 0.9], "brake.factors"),  # one car
+    (FLUID_BASE, "scene.name", 3, "scene.name"),
+    (BASE, "mesh.counts", [2, 2, 2], "mesh"),  # [mesh] needs [fluid]
+    (BASE, "outputs.snapshot_every", 0.5, "outputs.snapshot_every"),  # no snapshots of rigid runs
+    (SLOSH_BASE, "solver.t_end", 0.0, "solver.t_end"),
+    (SLOSH_BASE, "solver.step", 2.0, "solver.step"),
+    (SLOSH_BASE, "solver.frame", "body", "solver.frame"),
+    (SLOSH_BASE, "tank.shape", "sphere", "tank.shape"),
+    (SLOSH_BASE, "tank.radius", 1.0, "tank.radius"),  # not with an elliptic tank
+    (SLOSH_BASE, "maneuver.type", "slalom", "maneuver.type"),
+    (SLOSH_BASE, "maneuver.speed_mph", -5.0, "maneuver.speed_mph"),
+    (SLOSH_BASE, "maneuver.offset", 50.0, "maneuver.offset"),
+    (SLOSH_BASE, "maneuver.speed", 5.0, "maneuver.speed"),  # two speeds given
+    (SLOSH_BASE, "track", {"preset": "tangent"}, "track"),
+    (SLOSH_BASE, "outputs.vtu", True, "outputs.vtu"),
+    (SLOSH_BASE, "mesh.counts", [1, 2, 20], "mesh.counts[2]"),
+]
+
+
+def _set_dotted(base, path, value):
+    d = copy.deepcopy(base)
+    keys = path.split(".")
+    node = d
+    for k in keys[:-1]:
+        node = node.setdefault(k, {})
+    node[keys[-1]] = value
+    return d
+
+
+@pytest.mark.parametrize(("base", "path", "value", "fieldname"), BAD_NEW, ids=[f"{b[1]}={b[2]!r}" for b in BAD_NEW])
+def test_fluid_and_slosh_schema_errors_name_the_field(base, path, value, fieldname):
+    with pytest.raises(ValueError, match=rf"invalid parameter `{re.escape(fieldname)}") as err:
+        scene.load_scene(_set_dotted(base, path, value))
+    assert "allowed" in str(err.value)
+
+
+def test_custom_fluid_is_built_and_checked():
+    doc = _set_dotted(FLUID_BASE, "fluid", {"oil": "custom", "model": "bingham", "density": 950.0, "viscosity": 2.0})
+    doc["fluid"]["yield_stress"] = 10.0
+    sc = scene.load_scene(doc)
+    f = sc.fluid.make_fluid(1.5)
+    assert f.density == 950.0 and f.model == "bingham" and f.yield_stress == 10.0
+    assert f.bulk_penalty == pytest.approx(1000 * 950.0 * 9.81 * 1.5)
+    with pytest.raises(ValueError, match=r"invalid parameter `fluid.model`"):
+        scene.load_scene(_set_dotted(doc, "fluid.model", "maxwell"))
+    with pytest.raises(ValueError, match=r"invalid parameter `fluid.model`"):
+        scene.load_scene(_set_dotted(FLUID_BASE, "fluid", {"oil": "custom", "density": 900.0}))
+
+
+def test_lane_change_moves_the_tank_by_the_offset_and_stops_it():
+    """Integrating the piecewise-linear acceleration of a single lane change twice gives the
+    lateral offset with zero final velocity; the peak is 2 pi D / T^2."""
+    doc = _set_dotted(SLOSH_BASE, "maneuver", {"type": "lane_change", "speed": 10.0, "offset": 3.0, "length": 20.0})
+    doc["maneuver"]["double"] = False
+    doc["solver"]["t_end"] = 3.0
+    sc = scene.load_scene(doc)
+    pts = np.array(sc.motion().acceleration["y"])
+    t = np.linspace(0.0, 3.0, 300_001)
+    a = np.interp(t, pts[:, 0], pts[:, 1])
+    v = np.concatenate([[0.0], np.cumsum(0.5 * (a[1:] + a[:-1]) * np.diff(t))])
+    y = np.concatenate([[0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) * np.diff(t))])
+    T = 20.0 / 10.0
+    assert np.abs(pts[:, 1]).max() == pytest.approx(2 * np.pi * 3.0 / T**2, rel=1e-3)
+    assert y[-1] == pytest.approx(3.0, rel=5e-3) and abs(v[-1]) < 5e-3
+    # double lane change: back in the original lane
+    doc["maneuver"]["double"] = True
+    doc["solver"]["t_end"] = 6.0
+    pts = np.array(scene.load_scene(doc).motion().acceleration["y"])
+    t = np.linspace(0.0, 6.0, 600_001)
+    a = np.interp(t, pts[:, 0], pts[:, 1])
+    v = np.concatenate([[0.0], np.cumsum(0.5 * (a[1:] + a[:-1]) * np.diff(t))])
+    y = np.concatenate([[0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) * np.diff(t))])
+    assert abs(y[-1]) < 0.02 and y.max() == pytest.approx(3.0, rel=5e-3)
+
+
+@pytest.mark.parametrize("shape", ["half_round", "trapezoid"])
+def test_slow_bump_is_followed_quasi_statically_and_the_tank_comes_to_rest(shape):
+    """At crawling speed the low-pass suspension follows the road: the doubly integrated
+    acceleration reaches the bump height and returns to zero with zero velocity."""
+    doc = _set_dotted(SLOSH_BASE, "maneuver", {"type": "bump", "shape": shape, "height": 0.2, "speed": 0.1})
+    doc["maneuver"]["t0"] = 0.5
+    doc["solver"]["t_end"] = 20.0
+    sc = scene.load_scene(doc)
+    pts = np.array(sc.motion().acceleration["z"])
+    t = np.linspace(0.0, 20.0, 200_001)  # the trapezoid (1.4 m) is crossed in 14 s
+    a = np.interp(t, pts[:, 0], pts[:, 1])
+    v = np.concatenate([[0.0], np.cumsum(0.5 * (a[1:] + a[:-1]) * np.diff(t))])
+    z = np.concatenate([[0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) * np.diff(t))])
+    assert z.max() == pytest.approx(0.2, rel=0.03)
+    # 3 s (> 10 time constants 1/(zeta w)) after the bump the tank is back down, at rest
+    length = 0.4 if shape == "half_round" else (4 + 2 + 1) * 0.2
+    k = np.searchsorted(t, 0.5 + length / 0.1 + 3.0)
+    assert abs(z[k]) < 2e-3 and abs(v[k]) < 1e-3 and abs(a[k]) < 1e-3
+
+
+def test_all_examples_load_with_quick_overrides():
+    for p in EXAMPLES:
+        sc = scene.load_scene(p)
+        key = "solver" if sc.kind == "slosh" else "train"
+        quick = scene.load_scene(p, {key: {"t_end": 0.05}})
+        assert quick.t_end == pytest.approx(0.05) and quick.kind == sc.kind
+
+
+def test_slosh_scene_runs_and_reports_progress():
+    calls = []
+    sc = scene.load_scene(_set_dotted(SLOSH_BASE, "solver.t_end", 0.3))
+    res = scene.run_scene(sc, progress=lambda *a: calls.append(a))
+    assert res["scene"] is sc and res["t"][-1] == pytest.approx(0.3)
+    # first call after the first step, last call at the end; the counters never decrease
+    assert calls[0][2] == 1 and calls[-1][0] == pytest.approx(0.3) and calls[-1][1] == 0.3
+    assert calls[-1][2] == res["stats"]["steps"] and calls[-1][3] == res["stats"]["newton_iterations"]
+    for a, b in zip(calls, calls[1:], strict=False):
+        assert b[0] >= a[0] and b[2] >= a[2] and b[3] >= a[3] and b[4] >= a[4]
+
+
+class _Stop(Exception):
+    pass
+
+
+@pytest.mark.parametrize("which", ["rigid", "slosh"])
+def test_a_raising_progress_callback_stops_the_run(which):
+    def stop(*_a):
+        raise _Stop
+
+    sc = scene.load_scene(_set_dotted(BASE, "train.t_end", 5.0)) if which == "rigid" else scene.load_scene(SLOSH_BASE)
+    with pytest.raises(_Stop):
+        scene.run_scene(sc, progress=stop)
+
+
+@pytest.mark.parametrize(
+    ("axis", "accel", "factor"), [("z", 2 * 9.81, 3.0), ("z", -0.5 * 9.81, 1.0), ("y", 0.3 * 9.81, 1.0440307)]
+)
+def test_slosh_penalty_follows_the_largest_apparent_gravity(axis, accel, factor):
+    """k = 1000 rho g H x max |g - a| / g (at least 1): the volume strain stays 1e-3 at the peak."""
+    doc = _set_dotted(SLOSH_BASE, "maneuver", {"type": "pulse", "axis": axis, "acceleration": accel, "t1": 0.5})
+    sc = scene.load_scene(doc)
+    assert sc.peak_load_factor() == pytest.approx(factor, rel=1e-6)  # at rest (t = 0) it is 1
+    (_mesh, fluid, _tank, _motion), _kw = sc.run_args()
+    expected = 1000.0 * 998.0 * 9.81 * sc.depth() * max(sc.peak_load_factor(), 1.0)
+    assert fluid.bulk_penalty == pytest.approx(expected, rel=1e-9)
+    custom = _set_dotted(doc, "fluid", {"oil": "custom", "model": "newtonian", "density": 998.0, "bulk_penalty": 5e6})
+    (_m, f2, _t, _mo), _ = scene.load_scene(custom).run_args()
+    assert f2.bulk_penalty == 5e6  # a penalty given in the scene is kept
+
+
+def test_wall_stiffness_factor_reaches_the_slosh_run():
+    sc = scene.load_scene(ROOT / "examples/scenes/swri_lane_change_20mph.toml")
+    assert sc.contact_stiffness_factor == 10.0 and sc.run_args()[1]["contact_stiffness_factor"] == 10.0
+    assert "contact_stiffness_factor" not in scene.load_scene(SLOSH_BASE).run_args()[1]
+    with pytest.raises(ValueError, match=r"invalid parameter `solver.contact_stiffness_factor` = 0.0"):
+        scene.load_scene(_set_dotted(SLOSH_BASE, "solver.contact_stiffness_factor", 0.0))

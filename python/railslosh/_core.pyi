@@ -1,12 +1,16 @@
 """Type stubs of the Rust extension module ``railslosh._core``."""
 
 import os
-from typing import Any
+from collections.abc import Callable
+from typing import Any, final
 
 import numpy as np
 import numpy.typing as npt
 
 __version__: str
+
+_Progress = Callable[[float, float, int, int, int], object]
+"""Progress callback of the runs: ``(t, t_end, steps, newton_iterations, rejected_steps)``."""
 
 class RailsloshError(Exception):
     """Base class of railslosh simulation errors."""
@@ -14,6 +18,7 @@ class RailsloshError(Exception):
 class DataNotFoundError(RailsloshError):
     """External reference data (e.g. the Manchester contact benchmark) were not found; the case is skipped."""
 
+@final
 class FluidMesh:
     """A structured ANCF fluid mesh (reference configuration, tank frame)."""
 
@@ -40,11 +45,12 @@ class FluidMesh:
     @property
     def kind(self) -> str: ...
 
+@final
 class Fluid:
     """A fluid: density, rheology and penalty parameters (validated on construction)."""
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         density: float,
         model: str,
         *,
@@ -56,7 +62,7 @@ class Fluid:
         bulk_penalty: float,
         bulk_damping: float = 0.0,
         shear_rate_reg: float = 1e-2,
-    ) -> None: ...
+    ) -> Fluid: ...
     @property
     def density(self) -> float: ...
     @property
@@ -70,17 +76,18 @@ class Fluid:
     @property
     def elastic_modulus(self) -> float: ...
 
+@final
 class FluidBody:
     """A meshed fluid body: reference data, constant mass matrix, forces and Jacobians."""
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         mesh: FluidMesh,
         fluid: Fluid,
         viscous_points: int = 3,
         penalty_points: int = 3,
         mass_points: int = 4,
-    ) -> None: ...
+    ) -> FluidBody: ...
     @property
     def n_coords(self) -> int: ...
     @property
@@ -143,17 +150,25 @@ def run_slosh(
     gravity: list[float] = ...,
     viscous_points: int = 3,
     penalty_points: int = 3,
+    progress: _Progress | None = None,
+    volume_tolerance: float = 0.01,
+    penetration_limit: float = 0.5,
+    contact_stiffness_factor: float = 1.0,
+    stream: str | os.PathLike[str] | None = None,
 ) -> dict[str, Any]: ...
 def run_validation(name: str, quick: bool = False) -> list[dict[str, Any]]: ...
+def work_precision_cases() -> list[str]: ...
+def run_work_precision(case: str, quick: bool = False) -> list[dict[str, Any]]: ...
 def _panic_for_test() -> None: ...
 
 _F64 = npt.NDArray[np.float64]
 
+@final
 class Track:
     """Track geometry from a segment table (columns of equal length; see railslosh.rail.Track)."""
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         s: _F64,
         curvature: _F64,
         superelevation: _F64,
@@ -162,11 +177,11 @@ class Track:
         cant_left: _F64,
         *,
         units: str = "si",
-        gauge: float = 1.435,
-        cant_base: float = 1.5,
-        origin: tuple[float, float, float] = (0.0, 0.0, 0.0),
+        gauge: float = ...,  # 1.435 m
+        cant_base: float = ...,  # 1.5 m
+        origin: tuple[float, float, float] = ...,  # (0, 0, 0)
         heading: float = 0.0,
-    ) -> None: ...
+    ) -> Track: ...
     @property
     def gauge(self) -> float: ...
     @property
@@ -190,6 +205,7 @@ class Track:
     def rail_inward_cant(self, s: _F64, side: str) -> _F64: ...
     def project(self, points: _F64) -> tuple[_F64, _F64, _F64]: ...
 
+@final
 class Profile:
     """A wheel or rail profile z(y) (m; y towards the field side, z up)."""
 
@@ -277,6 +293,7 @@ def run_train(
     coupler_stiffness: float | None = None,
     coupler_damping: float | None = None,
     car: dict[str, float] | None = None,
+    progress: _Progress | None = None,
 ) -> dict[str, Any]: ...
 def design_brake_torque(
     mass: float, v0: float = ..., v1: float = ..., duration: float = 10.0
@@ -298,9 +315,75 @@ def run_fluid_train(
     brake_factors: list[float] | None = None,
     oil: str = "light",
     fluid: Fluid | None = None,
-    counts: tuple[int, int, int] = (6, 4, 2),
+    counts: tuple[int, int, int] = ...,
     fill: float = 0.5,
     bulkheads: list[tuple[float, float]] | None = None,
     wheel_profile: str = "s1002",
     car: dict[str, float] | None = None,
+    progress: _Progress | None = None,
 ) -> dict[str, Any]: ...
+
+# --- co-simulation: the slosh participant (rail_mbs::cosim, issue 6) ---
+
+_Vec3 = npt.ArrayLike
+_TankInput = dict[str, Any]
+"""Tank motion at one coupling time. Tank-frame form (seed 003, tank axes): keys
+``acceleration``, ``angular_velocity``, ``angular_acceleration``, ``gravity`` (missing: zero,
+gravity (0, 0, -g)). Pose form (global axes), recognised by ``rotation`` (3x3, tank -> global)
+or ``quaternion`` ([w, x, y, z]): keys ``position``, ``rotation``/``quaternion``, ``velocity``,
+``angular_velocity``, ``acceleration``, ``angular_acceleration`` (missing vectors: zero)."""
+
+@final
+class SloshParticipantState:
+    """Opaque saved state of a SloshParticipant (exact rollback)."""
+
+    @property
+    def time(self) -> float: ...
+    def to_bytes(self) -> bytes: ...
+    @staticmethod
+    def from_bytes(data: bytes) -> SloshParticipantState: ...
+
+@final
+class SloshParticipant:
+    """The slosh model as a co-simulation participant: loads are the force and moment of the
+    fluid on the tank, tank axes, moment about ``reference_point`` (tank frame)."""
+
+    def __new__(
+        cls,
+        mesh: FluidMesh,
+        fluid: Fluid,
+        tank_shape: str,
+        tank_dims: list[float],
+        bulkheads: list[tuple[float, float]] = ...,
+        h_max: float = 0.005,
+        reference_point: tuple[float, float, float] | list[float] = ...,
+        gravity: float = 9.81,
+        t0: float = 0.0,
+        viscous_points: int = 3,
+        penalty_points: int = 3,
+    ) -> SloshParticipant: ...
+    def advance(
+        self, t_end: float, input_start: _TankInput, input_end: _TankInput
+    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+    def set_initial_input(self, input: _TankInput) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+    def settle(self, duration: float, input: _TankInput) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+    def save_state(self) -> SloshParticipantState: ...
+    def restore_state(self, state: SloshParticipantState) -> None: ...
+    def added_mass(self) -> npt.NDArray[np.float64]: ...
+    def loads(self) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+    @property
+    def time(self) -> float: ...
+    @property
+    def fluid_mass(self) -> float: ...
+    @property
+    def com_tank(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def volume(self) -> float: ...
+    @property
+    def reference_point(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def h_max(self) -> float: ...
+    @property
+    def stats(self) -> dict[str, Any]: ...
+
+def seed003_maneuvers(dt: float = 0.005, t_after: float = 2.0, gravity: float = 9.81) -> list[dict[str, Any]]: ...

@@ -33,6 +33,29 @@ the section; ``scope = "all"`` (ECP: every car) or ``"front"``.
 ``[car]``: overrides of any key of :func:`railslosh.vehicle.tank_car_parameters` except ``dof``
 and ``total_mass``, and ``wheel_profile = "s1002" | "aar1b"``.
 
+``[brake]`` may instead say ``design = true``: the torque table of
+:func:`railslosh.vehicle.design_brake_torque` that slows the loaded car (liquid included) from the
+train speed to ``design_v1_kmh`` (default 5) in ``design_duration`` s (default 10), the design of
+seed 000 §8.2; ``factors`` (one per car, 0 to 10) scale it per car (fluid scenes only).
+
+**Liquid cargo (ANCF fluid in every tank, run with** :func:`railslosh.vehicle.run_fluid` **).**
+A ``[fluid]`` section turns a vehicle scene into a coupled car-oil scene:
+
+``[fluid]``: ``oil = "light" | "medium" | "heavy" | "water" | "custom"`` (seed 000 Table 2 crude oils,
+Oldroyd model); ``fill`` (liquid volume as a fraction of the tank volume, 0.1 to 0.9); for ``"custom"``: ``model``
+(``"newtonian"``, ``"bingham"``, ``"herschel-bulkley"``, ``"oldroyd"``, ``"casson"``), ``density``
+(kg/m^3), ``viscosity`` (Pa s), ``yield_stress`` (Pa), ``consistency``, ``power_index``,
+``elastic_modulus`` (Pa), ``bulk_penalty`` (Pa, default 1000 rho g depth) and ``bulk_damping``.
+``[mesh]``: ``counts = [n_length, n_width, n_height]`` fluid elements (1-40, 2-20, 1-10).
+``[tank]``: ``bulkheads = [[x, thickness], ...]`` in the tank frame (m; full-height plates; each
+compartment needs at least one element along the length).
+``[outputs]``: ``snapshot_every`` (s, fluid mesh snapshots for ParaView; 0 = none), ``netcdf``,
+``vtu``, ``plots`` (booleans, what ``railslosh run`` writes). Rigid lading, coupler overrides and
+wheelset offsets are not available with liquid cargo.
+
+**Prescribed-motion slosh scenes** (a ``[maneuver]`` section; run with
+:func:`railslosh.slosh.run`): see :class:`SloshScene`.
+
 Every error (unknown section or key, wrong type, value out of range) is a ``ValueError`` that names
 the dotted field and what is allowed, e.g. ``invalid parameter `train.speed` = 250.0: allowed 0 to
 70 m/s``.
@@ -55,7 +78,17 @@ import numpy as np
 
 from railslosh import rail, vehicle
 
-__all__ = ["PRESETS", "Scene", "load_scene", "run_scene", "scene_from_dict"]
+__all__ = [
+    "OILS",
+    "PRESETS",
+    "FluidSpec",
+    "Outputs",
+    "Scene",
+    "SloshScene",
+    "load_scene",
+    "run_scene",
+    "scene_from_dict",
+]
 
 FOOT = 0.3048
 INCH = 0.0254
@@ -96,7 +129,10 @@ _US_COLUMNS = (
     ("cant_left", -0.1, 0.1, "rad"),
 )
 _MAX_ROWS = 10_000
-_SECTIONS = ("track", "train", "brake", "lading", "car")
+_SECTIONS = ("track", "train", "brake", "lading", "car", "scene", "fluid", "mesh", "tank", "outputs")
+OILS = ("light", "medium", "heavy", "water", "custom")
+"""Names accepted by ``[fluid] oil``."""
+_FLUID_MODELS = ("newtonian", "bingham", "herschel-bulkley", "oldroyd", "casson")
 _WHEEL_PROFILES = ("s1002", "aar1b")
 _BRAKE_SCOPES = ("all", "front")
 _MAX_SPEED = 70.0  # m/s (252 km/h)
@@ -182,6 +218,94 @@ def _car_range(key: str, default: float) -> tuple[float, float]:
 
 
 @dataclass(frozen=True)
+class Outputs:
+    """What ``railslosh run`` writes (``[outputs]``)."""
+
+    netcdf: bool = True
+    """``results.nc``: the time series as an xarray Dataset."""
+    vtu: bool = True
+    """``fluid/*.vtu`` and ``fluid.pvd``: fluid mesh snapshots for ParaView (needs ``snapshot_every``)."""
+    plots: bool = True
+    """PNG plots of the main time series."""
+    snapshot_every: float = 0.0
+    """Interval of fluid mesh snapshots, s (0 = none)."""
+
+    def to_section(self) -> dict[str, Any]:
+        """The ``[outputs]`` table."""
+        return dataclasses.asdict(self)
+
+
+@dataclass(frozen=True)
+class FluidSpec:
+    """The liquid of a scene: ``[fluid]``, ``[mesh]`` and the bulkheads of ``[tank]``."""
+
+    oil: str = "light"
+    fill: float = 0.5
+    counts: tuple[int, int, int] = (6, 4, 2)
+    bulkheads: tuple[tuple[float, float], ...] = ()
+    custom: Mapping[str, Any] = field(default_factory=dict)
+    """Constructor arguments of :class:`railslosh.Fluid` when ``oil = "custom"``."""
+
+    def make_fluid(self, depth: float, element_height: float | None = None) -> Any:
+        """The :class:`railslosh.Fluid` for a liquid ``depth`` m deep: penalty ``k = 1000 rho g depth``
+        and, when ``element_height`` is given, bulk damping ``0.2 sqrt(k rho) element_height`` (the
+        defaults of the slosh validation cases) unless the scene sets them."""
+        from railslosh import fluids
+
+        rho = self.density()
+        k = float(self.custom.get("bulk_penalty", fluids.default_bulk_penalty(rho, depth)))
+        c = 0.0 if element_height is None else 0.2 * math.sqrt(k * rho) * element_height
+        c = float(self.custom.get("bulk_damping", c))
+        if self.oil == "custom":
+            args = {key: v for key, v in self.custom.items() if key not in ("density", "model")}
+            args |= {"bulk_penalty": k, "bulk_damping": c}
+            try:
+                return fluids.Fluid(rho, self.custom["model"], **args)
+            except ValueError as exc:
+                msg = re.sub(r"invalid parameter `([^`]+)`", r"invalid parameter `fluid.\1`", str(exc))
+                raise ValueError(
+                    msg if msg.startswith("invalid parameter") else f"invalid parameter `fluid`: {msg}"
+                ) from exc
+        if self.oil == "water":
+            return fluids.newtonian(998.0, 1.0e-3, bulk_penalty=k, bulk_damping=c)
+        _, mu, tau0 = fluids.CRUDE_OILS[self.oil]
+        return fluids.oldroyd(rho, mu, tau0, bulk_penalty=k, bulk_damping=c)
+
+    def density(self) -> float:
+        """Liquid density, kg/m^3."""
+        if self.oil == "custom":
+            return float(self.custom["density"])
+        if self.oil == "water":
+            return 998.0
+        from railslosh import fluids
+
+        return fluids.CRUDE_OILS[self.oil][0]
+
+    def mass(self, params: Mapping[str, float]) -> float:
+        """Liquid mass per car, kg (density times the exact liquid volume of the car's tank)."""
+        from railslosh import mesh
+
+        m = mesh.cylinder_tank(
+            length=params["tank_length"] - 1.0,
+            radius=params["tank_radius"],
+            head_depth=0.5,
+            fill=self.fill,
+            n_length=2,
+            n_width=2,
+            n_height=2,
+        )
+        return self.density() * m.exact_volume
+
+    def to_sections(self) -> dict[str, Any]:
+        """The ``[fluid]``, ``[mesh]`` and ``[tank]`` tables of this liquid."""
+        fl: dict[str, Any] = {"oil": self.oil, "fill": self.fill, **self.custom}
+        d: dict[str, Any] = {"fluid": fl, "mesh": {"counts": list(self.counts)}}
+        if self.bulkheads:
+            d["tank"] = {"bulkheads": [list(b) for b in self.bulkheads]}
+        return d
+
+
+@dataclass(frozen=True)
 class Scene:
     """A validated vehicle scene; every field is in SI units. :meth:`run_kwargs` gives the
     arguments of :func:`railslosh.vehicle.run`."""
@@ -208,6 +332,20 @@ class Scene:
     lading_height: float = 0.0
     car: Mapping[str, float] = field(default_factory=dict)
     wheel_profile: str = "s1002"
+    name: str = ""
+    """Title of the scene (``[scene] name``)."""
+    description: str = ""
+    fluid: FluidSpec | None = None
+    """Liquid cargo (``[fluid]``, ``[mesh]``, ``[tank]``); ``None`` = rigid lading only."""
+    brake_factors: tuple[float, ...] | None = None
+    brake_design: Mapping[str, float] | None = None
+    """``{"v1": m/s, "duration": s}`` when ``[brake] design = true`` (times/torques then computed)."""
+    outputs: Outputs = field(default_factory=lambda: Outputs())
+
+    @property
+    def kind(self) -> str:
+        """``"vehicle"`` (rigid lading) or ``"fluid_vehicle"`` (ANCF liquid in the tanks)."""
+        return "vehicle" if self.fluid is None else "fluid_vehicle"
 
     def track(self) -> rail.Track:
         """The track as a :class:`railslosh.rail.Track`."""
@@ -237,10 +375,37 @@ class Scene:
             "car": dict(self.car) or None,
         }
 
+    def fluid_kwargs(self) -> dict[str, Any]:
+        """Keyword arguments of :func:`railslosh.vehicle.run_fluid` (after the track)."""
+        if self.fluid is None:
+            raise ValueError("invalid parameter `fluid` = None: allowed a scene with a [fluid] section")
+        kw = self.run_kwargs()
+        for k in ("lading_mass", "lading_height", "wheelset_lateral_offset", "coupler_stiffness", "coupler_damping"):
+            kw.pop(k)
+        f = self.fluid
+        kw |= {
+            "oil": f.oil if f.oil != "custom" else "light",
+            "fluid": f.make_fluid(2.0 * self.tank_radius() * f.fill) if f.oil == "custom" else None,
+            "counts": f.counts,
+            "fill": f.fill,
+            "bulkheads": [tuple(b) for b in f.bulkheads] or None,
+            "snapshot_every": self.outputs.snapshot_every,
+            "brake_factors": None if self.brake_factors is None else list(self.brake_factors),
+        }
+        return kw
+
+    def tank_radius(self) -> float:
+        """Tank radius of the car, m (default or ``[car] tank_radius``)."""
+        return float({**_car_defaults(), **self.car}["tank_radius"])
+
     def replace(self, **changes: Any) -> Scene:
         """A copy with fields changed, validated again (e.g. ``scene.replace(t_end=0.1)``)."""
         new = scene_from_dict(_to_dict(dataclasses.replace(self, **changes)))
         return dataclasses.replace(new, track_source=self.track_source)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The scene as a TOML-like dict (SI units) that :func:`load_scene` reads back."""
+        return _to_dict(self)
 
 
 def _to_dict(sc: Scene) -> dict[str, Any]:
@@ -264,6 +429,20 @@ def _to_dict(sc: Scene) -> dict[str, Any]:
     if sc.lading_mass or sc.lading_height:
         d["lading"] = {"mass": sc.lading_mass, "height": sc.lading_height}
     d["car"] = {**sc.car, "wheel_profile": sc.wheel_profile}
+    if sc.brake_design is not None:
+        d["brake"] = {
+            "design": True,
+            "design_v1_kmh": sc.brake_design["v1"] * 3.6,
+            "design_duration": sc.brake_design["duration"],
+            "scope": sc.brake_scope,
+        }
+    if sc.brake_factors is not None:
+        d.setdefault("brake", {})["factors"] = list(sc.brake_factors)
+    if sc.name or sc.description:
+        d["scene"] = {"name": sc.name, "description": sc.description}
+    if sc.fluid is not None:
+        d |= sc.fluid.to_sections()
+    d["outputs"] = sc.outputs.to_section()
     return d
 
 
@@ -389,10 +568,31 @@ def scene_from_dict(data: Mapping[str, Any]) -> Scene:
         )
 
     br = _table(data.get("brake", {}), "brake")
-    _check_keys(br, "brake", ("times", "torques", "scope"))
+    _check_keys(br, "brake", ("times", "torques", "scope", "design", "design_v1_kmh", "design_duration", "factors"))
     brake_times = brake_torques = None
     scope = _choice(br.get("scope", "all"), "brake.scope", _BRAKE_SCOPES)
-    if br and ("times" not in br or "torques" not in br):
+    design = br.get("design", False)
+    if not isinstance(design, bool):
+        raise _fail("brake.design", design, "true or false")
+    brake_design = None
+    if design:
+        if "times" in br or "torques" in br:
+            raise _fail("brake.design", design, "either `brake.design = true` or `brake.times`/`brake.torques`")
+        v1 = _number(br.get("design_v1_kmh", 5.0), "brake.design_v1_kmh", 0.0, speed * 3.6, "km/h (<= train speed)")
+        duration = _number(br.get("design_duration", 10.0), "brake.design_duration", 1.0, 600.0, "s")
+        if speed <= v1 / 3.6:
+            raise _fail("train.speed", speed, "> brake.design_v1_kmh for a designed brake")
+        brake_design = {"v1": v1 / 3.6, "duration": duration}
+    else:
+        for k in ("design_v1_kmh", "design_duration"):
+            if k in br:
+                raise _fail(f"brake.{k}", br[k], "only with `brake.design = true`")
+    factors = None
+    if "factors" in br:
+        factors = tuple(_number_list(br["factors"], "brake.factors", 0.0, 10.0, ""))
+        if len(factors) > cars:
+            raise _fail("brake.factors", br["factors"], f"at most {cars} numbers, one per car")
+    if br and not design and ("times" not in br or "torques" not in br) and ("times" in br or "torques" in br):
         missing = "brake.times" if "times" not in br else "brake.torques"
         raise _fail(missing, None, "both `brake.times` and `brake.torques` in a [brake] section")
     if "times" in br:
@@ -408,6 +608,32 @@ def scene_from_dict(data: Mapping[str, Any]) -> Scene:
     lading_mass = _number(ld.get("mass", 0.0), "lading.mass", 0.0, 150_000.0, "kg")
     radius = params["tank_radius"]
     lading_height = _number(ld.get("height", 0.0), "lading.height", -radius, radius, "m (within the tank radius)")
+
+    name, description = _meta(data)
+    fluid = None
+    if "fluid" in data:
+        fluid = _fluid_spec(data, params)
+        for sec, key, val in (
+            ("lading", "mass", lading_mass),
+            ("train", "wheelset_lateral_offset", offset),
+            ("train", "coupler_stiffness", coupler_k),
+            ("train", "coupler_damping", coupler_c),
+        ):
+            if val:
+                raise _fail(f"{sec}.{key}", val, "not set in a scene with liquid cargo ([fluid])")
+    else:
+        for sec in ("mesh", "tank"):
+            if sec in data:
+                raise _fail(sec, data[sec], "only with a [fluid] section (liquid cargo)")
+        if factors is not None:
+            raise _fail("brake.factors", list(factors), "only with a [fluid] section (liquid cargo)")
+    outputs = _outputs(data, fluid is not None, record_every)
+    if brake_design is not None:
+        mass = _car_parameters_total(car, wheel_profile) + lading_mass
+        if fluid is not None:
+            mass += fluid.mass(params)
+        times, torques = vehicle.design_brake_torque(mass, speed, brake_design["v1"], brake_design["duration"])
+        brake_times, brake_torques = tuple(times), tuple(torques)
 
     return Scene(
         track_rows=tuple(tuple(r) for r in rows),
@@ -429,7 +655,123 @@ def scene_from_dict(data: Mapping[str, Any]) -> Scene:
         lading_height=lading_height,
         car=car,
         wheel_profile=wheel_profile,
+        name=name,
+        description=description,
+        fluid=fluid,
+        brake_factors=factors,
+        brake_design=brake_design,
+        outputs=outputs,
     )
+
+
+def _car_parameters_total(car: Mapping[str, float], wheel_profile: str) -> float:
+    return float(vehicle.tank_car_parameters(dict(car) or None, wheel_profile)["total_mass"])
+
+
+def _meta(data: Mapping[str, Any]) -> tuple[str, str]:
+    sec = _table(data.get("scene", {}), "scene")
+    _check_keys(sec, "scene", ("name", "description"))
+    out = []
+    for k in ("name", "description"):
+        v = sec.get(k, "")
+        if not isinstance(v, str) or len(v) > 2000:
+            raise _fail(f"scene.{k}", v, "a string of at most 2000 characters")
+        out.append(v)
+    return out[0], out[1]
+
+
+_CUSTOM_KEYS = {
+    "density": (100.0, 20_000.0, "kg/m^3"),
+    "viscosity": (0.0, 1e5, "Pa s"),
+    "yield_stress": (0.0, 1e5, "Pa"),
+    "consistency": (0.0, 1e5, "Pa s^n"),
+    "power_index": (0.05, 3.0, ""),
+    "elastic_modulus": (1e-3, 1e9, "Pa"),
+    "bulk_penalty": (1.0, 1e10, "Pa"),
+    "bulk_damping": (0.0, 1e8, "Pa s"),
+}
+
+
+def _fluid_section(fl: Mapping[str, Any]) -> tuple[str, dict[str, Any]]:
+    """``oil`` and the custom-fluid constructor arguments of a ``[fluid]`` table."""
+    oil = _choice(fl.get("oil", "light"), "fluid.oil", OILS)
+    custom: dict[str, Any] = {}
+    if oil == "custom":
+        if "model" not in fl or "density" not in fl:
+            raise _fail("fluid.model" if "model" not in fl else "fluid.density", None, 'given with oil = "custom"')
+        custom["model"] = _choice(fl["model"], "fluid.model", _FLUID_MODELS)
+        for k, (lo, hi, unit) in _CUSTOM_KEYS.items():
+            if k in fl:
+                custom[k] = _number(fl[k], f"fluid.{k}", lo, hi, unit)
+    else:
+        for k in ("model", *_CUSTOM_KEYS):
+            if k in fl:
+                raise _fail(f"fluid.{k}", fl[k], 'only with oil = "custom"')
+    return oil, custom
+
+
+def _counts(value: Any, fieldname: str, limits: tuple[tuple[int, int], ...]) -> tuple[int, int, int]:
+    if not isinstance(value, list | tuple) or len(value) != 3:
+        raise _fail(fieldname, value, "three integers [n_length, n_width, n_height]")
+    c = [_integer(x, f"{fieldname}[{i}]", *limits[i]) for i, x in enumerate(value)]
+    return c[0], c[1], c[2]
+
+
+def _bulkheads(value: Any, fieldname: str, half_length: float, n_length: int) -> tuple[tuple[float, float], ...]:
+    """Bulkheads ``[[x, thickness], ...]``: inside the shell, increasing, not overlapping, and every
+    compartment gets at least one element along the length."""
+    if not isinstance(value, list | tuple) or len(value) > 10:
+        raise _fail(fieldname, value, "a list of at most 10 [x, thickness] pairs")
+    out: list[tuple[float, float]] = []
+    for i, b in enumerate(value):
+        if not isinstance(b, list | tuple) or len(b) != 2:
+            raise _fail(f"{fieldname}[{i}]", b, "a pair [x (m), thickness (m)]")
+        th = _number(b[1], f"{fieldname}[{i}][1] (thickness)", 0.001, 0.5, "m", open_lo=False)
+        lim = half_length - th / 2 - 0.05
+        x = _number(b[0], f"{fieldname}[{i}][0] (x)", -lim, lim, "m (inside the cylindrical shell)")
+        if out and x - th / 2 <= out[-1][0] + out[-1][1] / 2:
+            raise _fail(
+                f"{fieldname}[{i}][0] (x)", x, f"increasing and clear of the previous bulkhead (> {out[-1][0]:g})"
+            )
+        out.append((x, th))
+    if len(out) + 1 > n_length:
+        raise _fail("mesh.counts[0]", n_length, f">= {len(out) + 1} (one element per compartment at least)")
+    return tuple(out)
+
+
+def _fluid_spec(data: Mapping[str, Any], params: Mapping[str, float]) -> FluidSpec:
+    fl = _table(data["fluid"], "fluid")
+    _check_keys(fl, "fluid", ("oil", "fill", "model", *_CUSTOM_KEYS))
+    oil, custom = _fluid_section(fl)
+    fill = _number(fl.get("fill", 0.5), "fluid.fill", 0.1, 0.9, "(volume fraction)")
+    ms = _table(data.get("mesh", {}), "mesh")
+    _check_keys(ms, "mesh", ("counts",))
+    counts = _counts(ms.get("counts", [6, 4, 2]), "mesh.counts", ((1, 40), (2, 20), (1, 10)))
+    tk = _table(data.get("tank", {}), "tank")
+    _check_keys(tk, "tank", ("bulkheads",))
+    half = 0.5 * (params["tank_length"] - 1.0)
+    bulkheads = _bulkheads(tk.get("bulkheads", []), "tank.bulkheads", half, counts[0])
+    spec = FluidSpec(oil=oil, fill=fill, counts=counts, bulkheads=bulkheads, custom=custom)
+    if oil == "custom":
+        spec.make_fluid(2.0 * params["tank_radius"] * fill)  # validates the custom fluid now
+    return spec
+
+
+def _outputs(data: Mapping[str, Any], has_snapshots: bool, record_every: float) -> Outputs:
+    out = _table(data.get("outputs", {}), "outputs")
+    _check_keys(out, "outputs", ("netcdf", "vtu", "plots", "snapshot_every"))
+    flags = {}
+    for k in ("netcdf", "vtu", "plots"):
+        v = out.get(k, True)
+        if not isinstance(v, bool):
+            raise _fail(f"outputs.{k}", v, "true or false")
+        flags[k] = v
+    snap = _number(out.get("snapshot_every", 0.0), "outputs.snapshot_every", 0.0, 600.0, "s")
+    if 0.0 < snap < record_every:
+        raise _fail("outputs.snapshot_every", snap, f"0 (none) or >= the recording interval {record_every:g} s")
+    if snap > 0 and not has_snapshots:
+        raise _fail("outputs.snapshot_every", snap, "0 in a scene without fluid mesh snapshots")
+    return Outputs(snapshot_every=snap, **flags)
 
 
 def _merge(base: Mapping[str, Any], over: Mapping[str, Any]) -> dict[str, Any]:
@@ -444,7 +786,392 @@ def _merge(base: Mapping[str, Any], over: Mapping[str, Any]) -> dict[str, Any]:
     return out
 
 
-def load_scene(source: str | os.PathLike[str] | Mapping[str, Any], overrides: Mapping[str, Any] | None = None) -> Scene:
+# --- prescribed-motion slosh scenes -------------------------------------------------------------
+
+MPH = 0.44704
+TANK_SHAPES = ("elliptic", "cylinder", "box")
+MANEUVERS = ("lane_change", "bump", "pulse", "samples")
+"""Names accepted by ``[maneuver] type``."""
+_SLOSH_SECTIONS = ("scene", "tank", "fluid", "mesh", "maneuver", "solver", "outputs")
+
+
+@dataclass(frozen=True)
+class SloshScene:
+    """A validated prescribed-motion slosh scene: a rigid tank moved by a maneuver, the liquid an
+    ANCF fluid mesh (run with :func:`railslosh.slosh.run`). Sections:
+
+    ``[tank]``: ``shape = "elliptic"`` (flat-ended cylinder of elliptical section; ``length``,
+    ``semi_axis_y``, ``semi_axis_z``; defaults: the SwRI tank of seed 003), ``"cylinder"`` (``length``
+    of the shell, ``radius``, ``head_depth``; defaults: the crude-oil tank car) or ``"box"`` (``lower``,
+    ``upper`` corners); ``bulkheads`` as in vehicle scenes (cylinder only).
+    ``[fluid]``: as in vehicle scenes (``oil``, ``fill`` as a volume fraction, custom
+    fluids). ``[mesh]``: ``counts``. ``[solver]``: ``t_end`` (s), ``step`` (s), ``frame``
+    (``"inertial"`` or ``"tank"``), ``contact_stiffness_factor`` (wall stiffness as a multiple of the
+    default penalty law, 0.1 to 1000). ``[outputs]``: ``netcdf``, ``plots``.
+    ``[maneuver]``: ``type`` =
+
+    * ``"lane_change"``: lateral (y) displacement ``offset`` (m, default 3.66 = 12 ft) over ``length``
+      (m, default 30.5 = 100 ft) at ``speed`` (m/s) or ``speed_mph``/``speed_kmh``; acceleration
+      ``a(t) = 2 pi offset / T^2 sin(2 pi (t - t0) / T)``, ``T = length / speed`` (zero velocity at both
+      ends); ``double = true`` (default) returns to the original lane after ``hold`` m (default 15.2);
+    * ``"bump"``: ``shape = "half_round" | "trapezoid"`` of ``height`` (m) or ``height_in``, crossed at
+      ``speed``; the tank's vertical motion is the road profile filtered by a second-order
+      low-pass standing for the suspension (``suspension_frequency`` Hz, default 2.0;
+      ``suspension_damping`` ratio, default 0.3); a trapezoid has ``ramp_up``, ``top`` and
+      ``ramp_down`` lengths (m; defaults 4, 2 and 1 times the height: asymmetric, steep exit);
+    * ``"pulse"``: ``axis``, ``acceleration`` (m/s^2), ``t0``, ``t1``, ``ramp`` (s);
+    * ``"samples"``: ``x``, ``y``, ``z`` = ``[[t, a], ...]`` piecewise-linear accelerations.
+
+    Every maneuver starts at ``t0`` (s, default 0.2).
+    """
+
+    tank: Any
+    """The :class:`railslosh.slosh.Tank`."""
+    fluid: FluidSpec
+    maneuver: Mapping[str, Any]
+    """The validated ``[maneuver]`` table, SI units."""
+    t_end: float = 2.0
+    step: float = 0.01
+    frame: str = "inertial"
+    contact_stiffness_factor: float = 1.0
+    """Wall stiffness as a multiple of the default penalty law (damping ratio kept)."""
+    name: str = ""
+    description: str = ""
+    outputs: Outputs = field(default_factory=lambda: Outputs(vtu=False))
+    raw: Mapping[str, Any] = field(default_factory=dict, compare=False, repr=False)
+
+    kind = "slosh"
+
+    def mesh(self) -> Any:
+        """The fluid mesh (reference configuration, tank frame)."""
+        from railslosh import mesh
+
+        d, (nl, nw, nh), fill = self.tank.dims, self.fluid.counts, self.fluid.fill
+        if self.tank.shape == "elliptic":
+            return mesh.elliptic_cylinder(
+                length=d[0],
+                semi_axis_y=d[1],
+                semi_axis_z=d[2],
+                fill=fill,
+                n_length=nl,
+                n_width=nw,
+                n_height=nh,
+            )
+        if self.tank.shape == "cylinder":
+            return mesh.cylinder_tank(
+                length=d[0],
+                radius=d[1],
+                head_depth=d[2],
+                fill=fill,
+                n_length=nl,
+                n_width=nw,
+                n_height=nh,
+            )
+        lo, hi = d[:3], d[3:]
+        size = (hi[0] - lo[0], hi[1] - lo[1], fill * (hi[2] - lo[2]))
+        return mesh.box(size, (nl, nw, nh), origin=lo)
+
+    def depth(self) -> float:
+        """Liquid depth of the mesh at rest, m."""
+        m = self.mesh()
+        return float(m.free_surface_z - m.nodes[:, 2].min())
+
+    def motion(self) -> Any:
+        """The :class:`railslosh.slosh.Motion` of the maneuver."""
+        return _motion(self.maneuver, self.t_end)
+
+    def peak_load_factor(self) -> float:
+        """Largest ``|g - a| / g`` of the maneuver (apparent gravity of the liquid, in g)."""
+        mo = self.motion()
+        times = sorted({t for pts in mo.acceleration.values() for t, _ in pts if t <= self.t_end} | {0.0})
+        acc = np.zeros((len(times), 3))
+        for i, ax in enumerate(("x", "y", "z")):
+            pts = mo.acceleration.get(ax)
+            if pts:
+                acc[:, i] = np.interp(times, [p[0] for p in pts], [p[1] for p in pts])
+        g = np.array([0.0, 0.0, -9.81])
+        return float(np.linalg.norm(g - acc, axis=1).max() / 9.81)
+
+    def run_args(self) -> tuple[tuple[Any, ...], dict[str, Any]]:
+        """Positional and keyword arguments of :func:`railslosh.slosh.run`. Unless the scene sets
+        ``fluid.bulk_penalty``, the penalty limits the volume strain to 1e-3 under the largest
+        apparent gravity of the maneuver (``k = 1000 rho g depth`` times :meth:`peak_load_factor`),
+        so that hard bumps stay within the run's volume-error guard."""
+        depth = self.depth()
+        spec = self.fluid
+        if "bulk_penalty" not in spec.custom:
+            k = 1000.0 * spec.density() * 9.81 * depth * max(1.0, self.peak_load_factor())
+            spec = dataclasses.replace(spec, custom={**spec.custom, "bulk_penalty": k})
+        fluid = spec.make_fluid(depth, depth / spec.counts[2])
+        kw: dict[str, Any] = {"t_end": self.t_end, "h": self.step, "frame": self.frame}
+        if self.contact_stiffness_factor != 1.0:
+            kw["contact_stiffness_factor"] = self.contact_stiffness_factor
+        return (self.mesh(), fluid, self.tank, self.motion()), kw
+
+    def to_dict(self) -> dict[str, Any]:
+        """The scene as parsed (a dict that :func:`load_scene` reads back)."""
+        return _merge(self.raw, {})
+
+
+def _speed(m: Mapping[str, Any], prefix: str) -> float:
+    given = [k for k in ("speed", "speed_mph", "speed_kmh") if k in m]
+    if len(given) != 1:
+        raise _fail(f"{prefix}.speed", None, "exactly one of `speed` (m/s), `speed_mph`, `speed_kmh`")
+    k = given[0]
+    scale = {"speed": 1.0, "speed_mph": MPH, "speed_kmh": 1 / 3.6}[k]
+    return _number(m[k], f"{prefix}.{k}", 0.0, _MAX_SPEED / scale, "", open_lo=True) * scale
+
+
+def _maneuver(m: Mapping[str, Any], t_end: float) -> dict[str, Any]:
+    kind = _choice(m.get("type"), "maneuver.type", MANEUVERS)
+    keys = {
+        "lane_change": ("speed", "speed_mph", "speed_kmh", "offset", "length", "double", "hold"),
+        "bump": (
+            "speed",
+            "speed_mph",
+            "speed_kmh",
+            "shape",
+            "height",
+            "height_in",
+            "suspension_frequency",
+            "suspension_damping",
+            "ramp_up",
+            "top",
+            "ramp_down",
+        ),
+        "pulse": ("axis", "acceleration", "t1", "ramp"),
+        "samples": ("x", "y", "z"),
+    }[kind]
+    _check_keys(m, "maneuver", ("type", "t0", *keys))
+    out: dict[str, Any] = {"type": kind, "t0": _number(m.get("t0", 0.2), "maneuver.t0", 0.0, 600.0, "s")}
+    if kind == "lane_change":
+        out["speed"] = _speed(m, "maneuver")
+        out["offset"] = _number(m.get("offset", 3.66), "maneuver.offset", 0.1, 20.0, "m")
+        out["length"] = _number(m.get("length", 30.5), "maneuver.length", 1.0, 1000.0, "m")
+        out["hold"] = _number(m.get("hold", 15.2), "maneuver.hold", 0.0, 1000.0, "m")
+        dbl = m.get("double", True)
+        if not isinstance(dbl, bool):
+            raise _fail("maneuver.double", dbl, "true or false")
+        out["double"] = dbl
+    elif kind == "bump":
+        out["speed"] = _speed(m, "maneuver")
+        out["shape"] = _choice(m.get("shape", "half_round"), "maneuver.shape", ("half_round", "trapezoid"))
+        if ("height" in m) == ("height_in" in m):
+            raise _fail("maneuver.height", m.get("height"), "exactly one of `height` (m) or `height_in`")
+        h = (
+            _number(m["height"], "maneuver.height", 0.001, 1.0, "m")
+            if "height" in m
+            else _number(m["height_in"], "maneuver.height_in", 0.04, 40.0, "in") * INCH
+        )
+        out["height"] = h
+        out["suspension_frequency"] = _number(
+            m.get("suspension_frequency", 2.0), "maneuver.suspension_frequency", 0.2, 50.0, "Hz"
+        )
+        out["suspension_damping"] = _number(
+            m.get("suspension_damping", 0.3), "maneuver.suspension_damping", 0.01, 2.0, ""
+        )
+        if out["shape"] == "trapezoid":
+            for k, f in (("ramp_up", 4.0), ("top", 2.0), ("ramp_down", 1.0)):
+                out[k] = _number(m.get(k, f * h), f"maneuver.{k}", 0.0 if k == "top" else 0.01, 100.0, "m")
+        else:
+            for k in ("ramp_up", "top", "ramp_down"):
+                if k in m:
+                    raise _fail(f"maneuver.{k}", m[k], 'only with shape = "trapezoid"')
+    elif kind == "pulse":
+        out["axis"] = _choice(m.get("axis", "x"), "maneuver.axis", ("x", "y", "z"))
+        out["acceleration"] = _number(m.get("acceleration", 0.0), "maneuver.acceleration", -50.0, 50.0, "m/s^2")
+        out["ramp"] = _number(m.get("ramp", 0.05), "maneuver.ramp", 1e-3, 10.0, "s", open_lo=False)
+        lo = out["t0"] + 2 * out["ramp"]
+        out["t1"] = _number(m.get("t1", t_end), "maneuver.t1", lo, 1e4, f"s (> t0 + 2 ramp = {lo:g})", open_lo=True)
+    else:
+        for ax in ("x", "y", "z"):
+            if ax in m:
+                rows = m[ax]
+                if not isinstance(rows, list | tuple) or not 2 <= len(rows) <= _MAX_ROWS:
+                    raise _fail(f"maneuver.{ax}", rows, f"a list of 2 to {_MAX_ROWS} pairs [t, a]")
+                pts = []
+                for i, r in enumerate(rows):
+                    if not isinstance(r, list | tuple) or len(r) != 2:
+                        raise _fail(f"maneuver.{ax}[{i}]", r, "a pair [t (s), a (m/s^2)]")
+                    pts.append(
+                        (
+                            _number(r[0], f"maneuver.{ax}[{i}][0] (t)", 0.0, 1e4, "s"),
+                            _number(r[1], f"maneuver.{ax}[{i}][1] (a)", -50.0, 50.0, "m/s^2"),
+                        )
+                    )
+                _increasing([p[0] for p in pts], lambda i, ax=ax: f"maneuver.{ax}[{i}][0] (t)")
+                out[ax] = pts
+    return out
+
+
+def _lane_change_samples(m: Mapping[str, Any], t_end: float) -> list[tuple[float, float]]:
+    T = m["length"] / m["speed"]
+    amp = 2.0 * math.pi * m["offset"] / T**2
+    n = 40
+    pts: list[tuple[float, float]] = [(0.0, 0.0)] if m["t0"] > 0 else []
+    starts = [(m["t0"], 1.0)]
+    if m["double"]:
+        starts.append((m["t0"] + T + m["hold"] / m["speed"], -1.0))
+    for t0, sign in starts:
+        for i in range(n + 1):
+            t = t0 + T * i / n
+            if pts and t <= pts[-1][0]:
+                continue
+            pts.append((t, sign * amp * math.sin(2.0 * math.pi * i / n)))
+    if pts[-1][0] < t_end:
+        pts.append((t_end + 1.0, 0.0))
+    return pts
+
+
+def _road_profile(m: Mapping[str, Any], x: np.ndarray) -> np.ndarray:
+    h = m["height"]
+    if m["shape"] == "half_round":
+        r = np.clip(x - h, -h, h)  # bump of radius h centred at x = h
+        return np.where((x > 0) & (x < 2 * h), np.sqrt(np.maximum(h * h - r * r, 0.0)), 0.0)
+    up, top, down = m["ramp_up"], m["top"], m["ramp_down"]
+    return np.interp(x, [0.0, up, up + top, up + top + down], [0.0, h, h, 0.0], left=0.0, right=0.0)
+
+
+def _bump_samples(m: Mapping[str, Any], t_end: float) -> list[tuple[float, float]]:
+    """Vertical acceleration of the tank crossing the bump: the road profile under the wheel,
+    filtered by the suspension taken as a second-order low-pass ``w^2 / (s^2 + 2 zeta w s + w^2)``
+    (frequency f, damping ratio zeta), sampled every 1 ms."""
+    from scipy import signal
+
+    w = 2.0 * math.pi * m["suspension_frequency"]
+    zeta = m["suspension_damping"]
+    dt = 2e-4
+    t = np.arange(0.0, t_end + dt, dt)
+    zr = _road_profile(m, m["speed"] * (t - m["t0"]))
+    sys = signal.StateSpace([[0.0, 1.0], [-w * w, -2.0 * zeta * w]], [[0.0], [w * w]], [[1.0, 0.0]], [[0.0]])
+    _, _, x = signal.lsim(sys, zr, t, interp=True)
+    a = -w * w * x[:, 0] - 2.0 * zeta * w * x[:, 1] + w * w * zr  # exact state acceleration
+    k = max(1, round(0.001 / dt))
+    idx = np.arange(0, len(t), k)
+    return [(float(t[i]), float(a[i])) for i in idx] + [(float(t[-1]) + 1.0, 0.0)]
+
+
+def _motion(m: Mapping[str, Any], t_end: float) -> Any:
+    from railslosh import slosh
+
+    mo = slosh.Motion()
+    if m["type"] == "lane_change":
+        mo.acceleration["y"] = _lane_change_samples(m, t_end)
+    elif m["type"] == "bump":
+        mo.acceleration["z"] = _bump_samples(m, t_end)
+    elif m["type"] == "pulse":
+        mo.pulse(m["axis"], m["acceleration"], m["t0"], m["t1"], ramp=m["ramp"])
+    else:
+        for ax in ("x", "y", "z"):
+            if ax in m:
+                mo.acceleration[ax] = [(float(t), float(a)) for t, a in m[ax]]
+    return mo
+
+
+def _slosh_tank(tk: Mapping[str, Any], counts: tuple[int, int, int]) -> Any:
+    from railslosh import mesh, slosh
+
+    _check_keys(
+        tk,
+        "tank",
+        ("shape", "length", "radius", "head_depth", "semi_axis_y", "semi_axis_z", "lower", "upper", "bulkheads"),
+    )
+    shape = _choice(tk.get("shape", "elliptic"), "tank.shape", TANK_SHAPES)
+    allowed = {
+        "elliptic": ("length", "semi_axis_y", "semi_axis_z"),
+        "cylinder": ("length", "radius", "head_depth", "bulkheads"),
+        "box": ("lower", "upper"),
+    }[shape]
+    for k in tk:
+        if k != "shape" and k not in allowed:
+            raise _fail(f"tank.{k}", tk[k], f"not with shape = {shape!r} (allowed: {', '.join(allowed)})")
+    if shape == "elliptic":
+        return slosh.elliptic_tank(
+            _number(tk.get("length", mesh.SWRI_LENGTH), "tank.length", 0.05, 50.0, "m"),
+            _number(tk.get("semi_axis_y", mesh.SWRI_SEMI_AXIS_Y), "tank.semi_axis_y", 0.02, 5.0, "m"),
+            _number(tk.get("semi_axis_z", mesh.SWRI_SEMI_AXIS_Z), "tank.semi_axis_z", 0.02, 5.0, "m"),
+        )
+    if shape == "cylinder":
+        length = _number(tk.get("length", mesh.TANK_CAR_LENGTH), "tank.length", 0.1, 50.0, "m")
+        radius = _number(tk.get("radius", mesh.TANK_CAR_RADIUS), "tank.radius", 0.05, 5.0, "m")
+        head = _number(tk.get("head_depth", mesh.TANK_CAR_HEAD_DEPTH), "tank.head_depth", 0.0, radius, "m (<= radius)")
+        bh = _bulkheads(tk.get("bulkheads", []), "tank.bulkheads", length / 2, counts[0])
+        return slosh.cylinder_tank(length, radius, head, bh)
+    lo = [_number(x, f"tank.lower[{i}]", -50.0, 50.0, "m") for i, x in enumerate(_list3(tk.get("lower"), "tank.lower"))]
+    hi = [_number(x, f"tank.upper[{i}]", -50.0, 50.0, "m") for i, x in enumerate(_list3(tk.get("upper"), "tank.upper"))]
+    for i in range(3):
+        if hi[i] <= lo[i] + 0.01:
+            raise _fail(f"tank.upper[{i}]", hi[i], f"> tank.lower[{i}] + 0.01 = {lo[i] + 0.01:g} m")
+    return slosh.box_tank((lo[0], lo[1], lo[2]), (hi[0], hi[1], hi[2]))
+
+
+def _list3(v: Any, fieldname: str) -> list[Any]:
+    if not isinstance(v, list | tuple) or len(v) != 3:
+        raise _fail(fieldname, v, "three numbers [x, y, z] (m)")
+    return list(v)
+
+
+def slosh_scene_from_dict(data: Mapping[str, Any]) -> SloshScene:
+    """Validates a parsed prescribed-motion scene (one with a ``[maneuver]`` section)."""
+    data = _table(data, "scene")
+    for k in data:
+        if k not in _SLOSH_SECTIONS:
+            raise ValueError(
+                f"invalid parameter `{k}`: unknown section of a slosh scene; allowed one of "
+                f"{', '.join(sorted(_SLOSH_SECTIONS))}"
+            )
+    name, description = _meta(data)
+    sv = _table(data.get("solver", {}), "solver")
+    _check_keys(sv, "solver", ("t_end", "step", "frame", "contact_stiffness_factor"))
+    wall = _number(sv.get("contact_stiffness_factor", 1.0), "solver.contact_stiffness_factor", 0.1, 1000.0, "")
+    t_end = _number(sv.get("t_end", 2.0), "solver.t_end", 0.0, 600.0, "s", open_lo=True)
+    step = _number(sv.get("step", 0.01), "solver.step", 1e-5, min(0.05, t_end), "s (<= t_end)")
+    frame = _choice(sv.get("frame", "inertial"), "solver.frame", ("inertial", "tank"))
+    fl = _table(data.get("fluid", {}), "fluid")
+    _check_keys(fl, "fluid", ("oil", "fill", "model", *_CUSTOM_KEYS))
+    oil, custom = _fluid_section(fl)
+    fill = _number(fl.get("fill", 0.5), "fluid.fill", 0.1, 0.9, "(volume fraction)")
+    ms = _table(data.get("mesh", {}), "mesh")
+    _check_keys(ms, "mesh", ("counts",))
+    counts = _counts(ms.get("counts", [2, 4, 2]), "mesh.counts", ((1, 40), (1, 40), (1, 10)))
+    tank = _slosh_tank(_table(data.get("tank", {}), "tank"), counts)
+    spec = FluidSpec(oil=oil, fill=fill, counts=counts, bulkheads=tank.bulkheads, custom=custom)
+    maneuver = _maneuver(_table(data.get("maneuver", {}), "maneuver"), t_end)
+    out = _table(data.get("outputs", {}), "outputs")
+    if out.get("vtu", False) is not False or "snapshot_every" in out:
+        raise _fail(
+            "outputs.vtu" if "vtu" in out else "outputs.snapshot_every",
+            out.get("vtu", out.get("snapshot_every")),
+            "not in a slosh scene (fluid snapshots come from vehicle scenes)",
+        )
+    outputs = dataclasses.replace(
+        _outputs({"outputs": {k: v for k, v in out.items() if k != "vtu"}}, False, step), vtu=False
+    )
+    sc = SloshScene(
+        tank=tank,
+        fluid=spec,
+        maneuver=maneuver,
+        t_end=t_end,
+        step=step,
+        frame=frame,
+        contact_stiffness_factor=wall,
+        name=name,
+        description=description,
+        outputs=outputs,
+        raw=dict(data),
+    )
+    try:
+        sc.mesh()
+        sc.fluid.make_fluid(sc.depth())
+    except ValueError as exc:
+        msg = str(exc)
+        raise ValueError(msg if msg.startswith("invalid parameter") else f"invalid parameter `mesh`: {msg}") from exc
+    return sc
+
+
+def load_scene(
+    source: str | os.PathLike[str] | Mapping[str, Any], overrides: Mapping[str, Any] | None = None
+) -> Scene | SloshScene:
     """Loads and validates a scene from a TOML file (path), TOML text or an already parsed dict.
 
     ``overrides`` is merged into the parsed scene section by section before validation, e.g.
@@ -466,15 +1193,31 @@ def load_scene(source: str | os.PathLike[str] | Mapping[str, Any], overrides: Ma
             raise ValueError(f"invalid scene TOML{f' in {source}' if is_path else ''}: {exc}") from exc
     if overrides is not None:
         data = _merge(_table(data, "scene"), _table(overrides, "overrides"))
+    if isinstance(data, Mapping) and "maneuver" in data:
+        return slosh_scene_from_dict(data)
     return scene_from_dict(data)
 
 
-def run_scene(scene: Scene | str | os.PathLike[str] | Mapping[str, Any]) -> dict[str, Any]:
-    """Runs a scene (a :class:`Scene`, or anything :func:`load_scene` takes) with
-    :func:`railslosh.vehicle.run`; returns its dict of arrays with ``"scene"`` added.
+def run_scene(
+    scene: Scene | SloshScene | str | os.PathLike[str] | Mapping[str, Any],
+    progress: Any = None,
+) -> dict[str, Any]:
+    """Runs a scene (a :class:`Scene` or :class:`SloshScene`, or anything :func:`load_scene` takes)
+    with :func:`railslosh.vehicle.run`, :func:`railslosh.vehicle.run_fluid` or
+    :func:`railslosh.slosh.run`; returns its dict of arrays with ``"scene"`` added.
 
+    ``progress(t, t_end, steps, newton_iterations, rejected_steps)`` is called during the run (about
+    every 0.5 s of wall time); if it raises, the run stops and the exception propagates.
     Raises :class:`railslosh.slosh.SimulationError` when the run stops early."""
-    sc = scene if isinstance(scene, Scene) else load_scene(scene)
-    res = vehicle.run(np.asarray(sc.track_rows, dtype=float), **sc.run_kwargs())
+    from railslosh import slosh
+
+    sc = scene if isinstance(scene, Scene | SloshScene) else load_scene(scene)
+    if isinstance(sc, SloshScene):
+        args, kw = sc.run_args()
+        res = slosh.run(*args, **kw, progress=progress)
+    elif sc.fluid is not None:
+        res = vehicle.run_fluid(np.asarray(sc.track_rows, dtype=float), **sc.fluid_kwargs(), progress=progress)
+    else:
+        res = vehicle.run(np.asarray(sc.track_rows, dtype=float), **sc.run_kwargs(), progress=progress)
     res["scene"] = sc
     return res

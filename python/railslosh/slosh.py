@@ -13,6 +13,9 @@ contact), moments about the tank origin, in tank and global axes (see docs/frame
 
 from __future__ import annotations
 
+import os
+import re
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from railslosh import _core
@@ -65,12 +68,34 @@ class Motion:
         return self
 
 
+#: Failure causes (``SimulationError.cause``) and the patterns of the Rust error messages
+#: that name them, matched in this order (the names are those of Rust's ``FailureCause``).
+FAILURE_CAUSES: tuple[tuple[str, str], ...] = (
+    ("contact_penetration", r"penetration .* beyond its limit"),
+    ("volume_error", r"volume .* deviates from its reference"),
+    ("inverted_element", r"inverted: J =|inverted element|J = [-+0-9.e]+ <= 0"),
+    ("singular_constraints", r"singular KKT matrix"),
+    ("non_finite", r"non-finite"),
+    ("newton_divergence", r"Newton iteration did not converge|below h_min"),
+)
+
+
+def failure_cause(message: str) -> str:
+    """Cause name of a failure message, ``"unknown"`` if it names none of :data:`FAILURE_CAUSES`."""
+    for name, pattern in FAILURE_CAUSES:
+        if re.search(pattern, message):
+            return name
+    return "unknown"
+
+
 class SimulationError(RailsloshError):
-    """A run stopped early; `.results` holds everything computed before the failure."""
+    """A run stopped early; `.results` holds everything computed before the failure and
+    `.cause` names why (one of :data:`FAILURE_CAUSES`, e.g. ``"inverted_element"``)."""
 
     def __init__(self, message: str, results: dict):
         super().__init__(message)
         self.results = results
+        self.cause = failure_cause(message)
 
 
 def run(
@@ -83,6 +108,11 @@ def run(
     h: float = 0.01,
     frame: str = "inertial",
     gravity: tuple[float, float, float] = (0.0, 0.0, -9.81),
+    progress: Callable[[float, float, int, int, int], object] | None = None,
+    volume_tolerance: float = 0.01,
+    penetration_limit: float = 0.5,
+    contact_stiffness_factor: float = 1.0,
+    stream: str | os.PathLike[str] | None = None,
 ) -> dict:
     """Integrate the fluid in the moving tank up to `t_end` with steps of at most `h`.
 
@@ -90,6 +120,20 @@ def run(
     pseudo-forces of seed 003 (appendix C, eq. 7.40). Returns a dict of numpy arrays
     (see ``railslosh._core.run_slosh``) and the integrator statistics under ``stats``.
     Raises :class:`SimulationError` (with ``.results``) if the run stops early.
+    ``progress(t, t_end, steps, newton_iterations, rejected_steps)`` is called after the first step,
+    then about every 0.5 s of wall time and at the end; if it raises, the run stops and the
+    exception propagates.
+
+    Failure guards, checked on every accepted step: the run stops with a
+    :class:`SimulationError` (``cause`` ``"volume_error"`` / ``"contact_penetration"``) when the
+    fluid volume deviates from its initial value by more than ``volume_tolerance`` (relative), or
+    a boundary point penetrates a wall deeper than ``penetration_limit`` times the smallest element
+    edge (``math.inf`` disables either). ``contact_stiffness_factor`` scales the wall-contact
+    penalty stiffness (damping ratio kept).
+
+    ``stream`` (a file path) writes every sample to that file as it is computed (flushed per step),
+    so a run that is interrupted -- killed, out of time -- loses nothing already computed; read it
+    with :func:`read_stream`, which returns the arrays of this function.
     """
     motion = motion or Motion()
     unknown = set(motion.acceleration) - set(AXES)
@@ -109,7 +153,44 @@ def run(
         h,
         frame,
         list(gravity),
+        progress=progress,
+        volume_tolerance=volume_tolerance,
+        penetration_limit=penetration_limit,
+        contact_stiffness_factor=contact_stiffness_factor,
+        stream=None if stream is None else os.fspath(stream),
     )
     if res["error"] is not None:
         raise SimulationError(f"slosh run stopped at t = {res['t'][-1]:.4f} s: {res['error']}", res)
     return res
+
+
+_STREAM_MAGIC = b"RSLJRNL1"
+_VECTORS = ("force_tank", "moment_tank", "force_global", "moment_global", "com_tank")
+_SCALARS = ("volume", "kinetic_energy", "potential_energy", "newton_iterations", "max_penetration")
+
+
+def read_stream(path: str | os.PathLike[str]) -> dict:
+    """The samples of a :func:`run` ``stream`` file (also of an interrupted run: every complete
+    sample), as the arrays of :func:`run` (``t``, ``force_tank`` (n, 3), ...), without ``stats``.
+    The format is the journal of ``rail_mbs::integrator::Journal`` (docs/robustness.md)."""
+    import numpy as np
+
+    with open(path, "rb") as f:
+        data = f.read()
+    if data[:8] != _STREAM_MAGIC or len(data) < 12:
+        raise ValueError(f"invalid parameter `path` = {os.fspath(path)!r}: allowed a slosh stream file")
+    ncol = int.from_bytes(data[8:12], "little")
+    pos, names = 12, []
+    for _ in range(ncol):
+        n = int.from_bytes(data[pos : pos + 4], "little")
+        names.append(data[pos + 4 : pos + 4 + n].decode())
+        pos += 4 + n
+    rows = (len(data) - pos) // (8 * ncol)
+    table = np.frombuffer(data, dtype="<f8", count=rows * ncol, offset=pos).reshape(rows, ncol)
+    col = {name: table[:, i].copy() for i, name in enumerate(names)}
+    out: dict = {"t": col["t"]}
+    for v in _VECTORS:
+        out[v] = np.stack([col[f"{v}_{a}"] for a in "xyz"], axis=1)
+    for k in _SCALARS:
+        out[k] = col[k].astype(np.int64) if k == "newton_iterations" else col[k]
+    return out

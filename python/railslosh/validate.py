@@ -3,7 +3,8 @@
 Each case returns records with the keys ``case, quantity, measured, reference, tolerance,
 passed``: one measured quantity against its reference. Element-level cases are implemented
 in Rust (``railslosh._core.run_validation``), so the CLI, the Python tests and the Rust
-tests run exactly the same checks.
+tests run exactly the same checks. Cases that only exercise Python code (the co-simulation
+masters, ``railslosh.cosim.cases``) are registered from Python.
 
 Cases that compare with external reference data (``manchester-contact-left`` reads the CONTACT
 benchmark files from ``$RAILSLOSH_SHARED_DATA/manchester-contact``, by default from
@@ -87,6 +88,17 @@ _DESCRIPTIONS = {
 CASES: dict[str, Case] = {
     name: Case(name, _DESCRIPTIONS.get(name, ""), _rust_case(name)) for name in _core.validation_cases()
 }
+
+
+def _python_cases() -> dict[str, Case]:
+    """Cases implemented in Python (name -> (description, run(quick) -> records))."""
+    from railslosh.cosim.cases import PY_CASES
+    from railslosh.fmu import FMU_CASES
+
+    return {name: Case(name, desc, fn) for name, (desc, fn) in {**PY_CASES, **FMU_CASES}.items()}
+
+
+CASES.update(_python_cases())
 
 
 def run(

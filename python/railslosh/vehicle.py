@@ -16,7 +16,7 @@ left; coupler forces are positive in tension.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -85,6 +85,7 @@ def run(
     coupler_stiffness: float | None = None,
     coupler_damping: float | None = None,
     car: dict[str, float] | None = None,
+    progress: Callable[[float, float, int, int, int], object] | None = None,
 ) -> dict[str, Any]:
     """Run ``cars`` coupled tank cars on ``track`` and return arrays of wheel loads ``Q``
     (``wheel_vertical``), lateral wheel forces ``Y``, ``l_over_v``, the wheel ``unloading`` ratio
@@ -93,6 +94,9 @@ def run(
     ``drive=True`` holds the front car to ``speed`` with the trajectory constraint (a number gives
     another speed); ``brake=(times, torques)`` applies that torque (N m) to every wheelset of the
     braked cars (``brake_scope`` ``"all"`` = ECP, ``"front"`` = front car only).
+    ``progress(t, t_end, steps, newton_iterations, rejected_steps)`` is called after the first step,
+    then about every 0.5 s of wall time and at the end; if it raises, the run stops and the
+    exception propagates.
 
     Raises ``ValueError`` naming a bad field, and :class:`railslosh.slosh.SimulationError` (with
     ``.results`` up to the failure) when the run stops early.
@@ -118,6 +122,7 @@ def run(
             coupler_stiffness=coupler_stiffness,
             coupler_damping=coupler_damping,
             car=car,
+            progress=progress,
         )
     )
     return _raise_on_error(res, "vehicle run")
@@ -153,6 +158,7 @@ def run_fluid(
     bulkheads: Sequence[tuple[float, float]] | None = None,
     wheel_profile: str = "s1002",
     car: dict[str, float] | None = None,
+    progress: Callable[[float, float, int, int, int], object] | None = None,
 ) -> dict[str, Any]:
     """Run tank cars whose tanks carry an ANCF fluid, solved monolithically with the cars.
 
@@ -162,6 +168,7 @@ def run_fluid(
     in the tank frame (m). Returns the arrays of :func:`run` plus ``oil_com_tank`` and ``oil_com_global``
     (samples, cars, 3), ``fluid_force_tank`` (the fluid's load on each tank, tank frame), ``volume_error``
     and ``snapshots`` (``[(t, [nodes x 4 x 3 per car])]``, position then gradients per node).
+    ``progress`` is called as in :func:`run`.
     """
     drive_speed, times, torques = _drive_and_brake(drive, speed, brake)
     res = dict(
@@ -186,6 +193,7 @@ def run_fluid(
             bulkheads=None if bulkheads is None else [(float(x), float(t)) for x, t in bulkheads],
             wheel_profile=wheel_profile,
             car=car,
+            progress=progress,
         )
     )
     return _raise_on_error(res, "fluid vehicle run")

@@ -1,6 +1,7 @@
 //! Railway multibody dynamics for railslosh.
 //!
 //! Modules are grouped by physics:
+//! - [`cosim`]: the slosh model as a co-simulation participant (seed 003);
 //! - [`integrator`]: the sparse implicit HHT-α integrator (faer sparse LU) that advances
 //!   rigid and ANCF bodies together;
 //! - [`track`]: track geometry from segment tables;
@@ -8,6 +9,7 @@
 //! - [`wheel_rail`]: wheel/rail contact search, Hertz normal contact and creep forces.
 #![warn(missing_docs)]
 
+pub mod cosim;
 pub mod integrator;
 pub mod mbs;
 pub mod profile;
@@ -15,3 +17,4 @@ pub mod slosh;
 pub mod track;
 pub mod vehicle;
 pub mod wheel_rail;
+pub mod work_precision;

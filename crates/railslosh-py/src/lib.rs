@@ -10,6 +10,8 @@
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
+mod bench;
+mod cosim;
 mod rail;
 mod vehicle;
 
@@ -47,6 +49,48 @@ fn compute<T: Send, F: FnOnce() -> Result<T, AncfError> + Send>(py: Python<'_>, 
             RailsloshError::new_err(format!("internal error (please report): {msg}"))
         })?
         .map_err(to_py)
+}
+
+/// Wall-time interval between two calls of a Python progress callback, s.
+const PROGRESS_INTERVAL: f64 = 0.5;
+
+/// Calls a Python progress callback `progress(t, t_end, steps, newton_iterations, rejected)`
+/// from a run that has released the GIL: after the first step, then at most every
+/// [`PROGRESS_INTERVAL`] s of wall time, and at the end (GIL held only for the call). A
+/// callback that raises stops the run; its exception is kept and re-raised by [`Self::finish`].
+pub(crate) struct PyProgress {
+    callback: Option<Py<PyAny>>,
+    last: Option<std::time::Instant>,
+    error: Option<PyErr>,
+}
+
+impl PyProgress {
+    pub(crate) fn new(callback: Option<Py<PyAny>>) -> Self {
+        Self { callback, last: None, error: None }
+    }
+
+    /// The observer of `rail_mbs` runs; `false` stops the run.
+    pub(crate) fn observe(&mut self, p: &rail_mbs::vehicle::Progress) -> bool {
+        let Some(cb) = &self.callback else { return true };
+        let done = p.t >= p.t_end - 1e-12 * (1.0 + p.t_end.abs());
+        if !done && self.last.is_some_and(|l| l.elapsed().as_secs_f64() < PROGRESS_INTERVAL) {
+            return true;
+        }
+        self.last = Some(std::time::Instant::now());
+        let args = (p.t, p.t_end, p.steps, p.newton_iterations, p.rejected_steps);
+        match Python::attach(|py| cb.call1(py, args).map(|_| ())) {
+            Ok(()) => true,
+            Err(e) => {
+                self.error = Some(e);
+                false
+            }
+        }
+    }
+
+    /// The callback's exception, if it raised.
+    pub(crate) fn finish(self) -> PyResult<()> {
+        self.error.map_or(Ok(()), Err)
+    }
 }
 
 /// (data, indices, indptr, shape) of a CSC matrix.
@@ -396,7 +440,9 @@ impl PyFluidBody {
 /// that stopped the run; the arrays then hold everything computed before it) and `stats`.
 #[pyfunction]
 #[pyo3(signature = (mesh, fluid, tank_shape, tank_dims, bulkheads, acceleration, rotation_axis, angular_acceleration,
-                    t_end, h, frame="inertial", gravity=[0.0, 0.0, -9.81], viscous_points=3, penalty_points=3))]
+                    t_end, h, frame="inertial", gravity=[0.0, 0.0, -9.81], viscous_points=3, penalty_points=3,
+                    progress=None, volume_tolerance=0.01, penetration_limit=0.5, contact_stiffness_factor=1.0,
+                    stream=None))]
 #[allow(clippy::too_many_arguments)]
 fn run_slosh<'py>(
     py: Python<'py>,
@@ -414,6 +460,11 @@ fn run_slosh<'py>(
     gravity: [f64; 3],
     viscous_points: usize,
     penalty_points: usize,
+    progress: Option<Py<PyAny>>,
+    volume_tolerance: f64,
+    penetration_limit: f64,
+    contact_stiffness_factor: f64,
+    stream: Option<std::path::PathBuf>,
 ) -> PyResult<Bound<'py, PyDict>> {
     use ancf_core::contact::{WallContact, WallContactLaw};
     use ancf_core::tank::{Bulkhead, TankGeometry, TankShape};
@@ -445,7 +496,18 @@ fn run_slosh<'py>(
     if !(h.is_finite() && h > 0.0 && h <= t_end) {
         return Err(bad("h", h.to_string(), "a finite number in (0, t_end]"));
     }
+    // Failure guards (issue 8): relative volume error and wall penetration per smallest element edge.
+    for (name, x) in [("volume_tolerance", volume_tolerance), ("penetration_limit", penetration_limit)] {
+        if x.is_nan() || x <= 0.0 {
+            return Err(bad(name, x.to_string(), "a number > 0 (inf disables the check)"));
+        }
+    }
+    if !(contact_stiffness_factor.is_finite() && contact_stiffness_factor > 0.0) {
+        return Err(bad("contact_stiffness_factor", contact_stiffness_factor.to_string(), "a finite number > 0"));
+    }
     let (m, f) = (mesh.inner.clone(), fluid.inner);
+    let mut observer = PyProgress::new(progress);
+    let obs = &mut observer;
     let result = compute(py, move || {
         let q = QuadratureOptions { viscous: viscous_points, penalty: penalty_points, mass: 4 };
         let body = FluidBody::new(m, f, q)?;
@@ -454,7 +516,11 @@ fn run_slosh<'py>(
         let depth =
             (body.mesh.free_surface_z - body.mesh.nodes.iter().map(|n| n[2]).fold(f64::INFINITY, f64::min)).max(1e-3);
         let g = (gravity[0].powi(2) + gravity[1].powi(2) + gravity[2].powi(2)).sqrt().max(1e-3);
-        let contact = WallContact::new(&body, geo, WallContactLaw::default_for(f.density, g, depth))?;
+        let mut law = WallContactLaw::default_for(f.density, g, depth);
+        // k × s with the damping ratio of the default law kept (c ∝ k^1.5 there)
+        law.stiffness *= contact_stiffness_factor;
+        law.damping *= contact_stiffness_factor.powf(1.5);
+        let contact = WallContact::new(&body, geo, law)?;
         let mut motion = PrescribedMotion::at_rest([0.0; 3]);
         let names = ["acceleration.x", "acceleration.y", "acceleration.z"];
         for d in 0..3 {
@@ -465,13 +531,27 @@ fn run_slosh<'py>(
         if let Some(axis) = rotation_axis {
             motion.rotation = Some((axis, PiecewiseAcceleration::new("angular_acceleration", &angular_acceleration)?));
         }
-        let sys = SloshSystem::new(body, contact, motion, gravity, frame)?;
+        let mut sys = SloshSystem::new(body, contact, motion, gravity, frame)?;
+        sys.volume_tolerance = volume_tolerance;
+        sys.penetration_limit *= penetration_limit / rail_mbs::slosh::system::PENETRATION_LIMIT_FACTOR;
         let mut run = SloshRun::new(sys, 0.0, rail_mbs::slosh::validate::slosh_params())
             .map_err(|e| AncfError::NonFinite { what: e.to_string(), element: 0 })?;
-        let err = run.run_to(t_end, h).err().map(|e| e.error.to_string());
+        let result = match &stream {
+            // Every sample appended and flushed as it is computed (issue 8: nothing computed is lost).
+            Some(path) => {
+                let columns = rail_mbs::slosh::SloshRecord::COLUMNS;
+                let mut journal = rail_mbs::integrator::Journal::create(path, &columns, 1).map_err(|e| {
+                    ancf_core::error::invalid("stream", path.display(), &format!("a writable file ({e})"))
+                })?;
+                run.run_to_journaled(t_end, h, &mut |p| obs.observe(p), &mut journal)
+            }
+            None => run.run_to_observed(t_end, h, &mut |p| obs.observe(p)),
+        };
+        let err = result.err().map(|e| e.error.to_string());
         let s = *run.stats();
         Ok((run.record, err, s))
     })?;
+    observer.finish()?;
     let (rec, err, stats) = result;
     let d = PyDict::new(py);
     let v3 = |x: &Vec<[f64; 3]>| -> PyResult<Bound<'py, PyAny>> {
@@ -570,8 +650,11 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(validation_cases, m)?)?;
     m.add_function(wrap_pyfunction!(run_slosh, m)?)?;
     m.add_function(wrap_pyfunction!(run_validation, m)?)?;
+    m.add_function(wrap_pyfunction!(bench::work_precision_cases, m)?)?;
+    m.add_function(wrap_pyfunction!(bench::run_work_precision, m)?)?;
     m.add_function(wrap_pyfunction!(_panic_for_test, m)?)?;
     rail::register(m)?;
     vehicle::register(m)?;
+    cosim::register(m)?;
     Ok(())
 }

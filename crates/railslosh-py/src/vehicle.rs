@@ -13,10 +13,10 @@ use rail_mbs::track::{Track, TrackPoint};
 use rail_mbs::vehicle::studies::{Oil, brake_torque};
 use rail_mbs::vehicle::{
     BrakeScope, FluidCargo, FluidTrainRecord, TankCarParams, TrainRecord, TrainScenario,
-    run_fluid_train as rust_run_fluid_train, run_train as rust_run_train,
+    run_fluid_train_observed as rust_run_fluid_train, run_train_observed as rust_run_train,
 };
 
-use crate::compute;
+use crate::{PyProgress, compute};
 
 /// Scalar fields of [`TankCarParams`] a user can override, with getters and setters.
 type Field = (&'static str, fn(&TankCarParams) -> f64, fn(&mut TankCarParams, f64));
@@ -180,7 +180,7 @@ fn brake_of(times: Option<Vec<f64>>, torques: Option<Vec<f64>>, scope: &str) -> 
     track, *, cars=1, station=50.0, speed=0.0, t_end=1.0, step=1e-3, record_every=0.01,
     drive_speed=None, brake_times=None, brake_torques=None, brake_scope="all",
     lading_mass=0.0, lading_height=0.0, wheel_profile="s1002", wheelset_lateral_offset=0.0,
-    coupler_stiffness=None, coupler_damping=None, car=None
+    coupler_stiffness=None, coupler_damping=None, car=None, progress=None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn run_train<'py>(
@@ -203,6 +203,7 @@ pub fn run_train<'py>(
     coupler_stiffness: Option<f64>,
     coupler_damping: Option<f64>,
     car: Option<&Bound<'py, PyDict>>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let mut params = car_params(car, wheel_profile)?;
     if lading_mass != 0.0 {
@@ -218,7 +219,10 @@ pub fn run_train<'py>(
     sc.brake = brake;
     sc.wheelset_lateral_offset = wheelset_lateral_offset;
     sc.coupler = (coupler_stiffness, coupler_damping);
-    let out = compute(py, move || rust_run_train(&sc))?;
+    let mut observer = PyProgress::new(progress);
+    let obs = &mut observer;
+    let out = compute(py, move || rust_run_train(&sc, &mut |p| obs.observe(p)))?;
+    observer.finish()?;
     match out {
         Ok(r) => record_dict(py, &r),
         Err(f) => {
@@ -258,6 +262,9 @@ fn fluid_record_dict<'py>(py: Python<'py>, r: &FluidTrainRecord) -> PyResult<Bou
     d.set_item("snapshots", snaps)?;
     d.set_item("fluid_mass", r.fluid_mass)?;
     d.set_item("elements", r.elements)?;
+    let conn: Vec<i64> = r.connectivity.iter().flatten().map(|&n| n as i64).collect();
+    let ne = r.connectivity.len();
+    d.set_item("connectivity", PyArray1::from_vec(py, conn).reshape([ne, 8])?)?;
     Ok(d)
 }
 
@@ -282,7 +289,8 @@ pub fn design_brake_torque(mass: f64, v0: f64, v1: f64, duration: f64) -> PyResu
 #[pyo3(signature = (
     track, *, cars=1, station=300.0, speed=0.0, t_end=1.0, step=4e-3, record_every=0.02, snapshot_every=0.0,
     drive_speed=None, brake_times=None, brake_torques=None, brake_scope="all", brake_factors=None,
-    oil="light", fluid=None, counts=(6, 4, 2), fill=0.5, bulkheads=None, wheel_profile="s1002", car=None
+    oil="light", fluid=None, counts=(6, 4, 2), fill=0.5, bulkheads=None, wheel_profile="s1002", car=None,
+    progress=None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn run_fluid_train<'py>(
@@ -307,6 +315,7 @@ pub fn run_fluid_train<'py>(
     bulkheads: Option<Vec<(f64, f64)>>,
     wheel_profile: &str,
     car: Option<&Bound<'py, PyDict>>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let params = car_params(car, wheel_profile)?;
     let brake = brake_of(brake_times, brake_torques, brake_scope)?;
@@ -329,7 +338,10 @@ pub fn run_fluid_train<'py>(
     sc.brake = brake;
     sc.brake_factors = brake_factors.unwrap_or_default();
     sc.hht.refresh_rate = 0.5;
-    let out = compute(py, move || rust_run_fluid_train(&sc, &cargo))?;
+    let mut observer = PyProgress::new(progress);
+    let obs = &mut observer;
+    let out = compute(py, move || rust_run_fluid_train(&sc, &cargo, &mut |p| obs.observe(p)))?;
+    observer.finish()?;
     match out {
         Ok(r) => fluid_record_dict(py, &r),
         Err(f) => {

@@ -60,6 +60,43 @@ pub enum SystemError {
         /// Human-readable cause.
         reason: String,
     },
+    /// A finite element inverted (volume ratio `J ≤ 0`) at a quadrature point.
+    #[error("element {element} inverted: J = {j:.3e} <= 0 at quadrature point {point}")]
+    InvertedElement {
+        /// Element index in the system's own numbering.
+        element: usize,
+        /// Quadrature point index in the element.
+        point: usize,
+        /// Volume ratio `J = det F` at that point.
+        j: f64,
+    },
+    /// A penalty contact penetrated beyond its admissible limit (checked on every
+    /// converged step through [`MechanicalSystem::check_step`](super::MechanicalSystem::check_step)).
+    #[error("contact penetration {depth:.3e} m beyond its limit {limit:.3e} m at {contact}")]
+    Penetration {
+        /// Which contact (e.g. "fluid-wall point 12 (element 3)").
+        contact: String,
+        /// Penetration depth, m.
+        depth: f64,
+        /// Admissible penetration, m.
+        limit: f64,
+    },
+    /// A nearly incompressible (penalty) body changed its volume beyond the admissible
+    /// relative error (checked on every converged step).
+    #[error(
+        "{what} volume {volume:.6e} m^3 deviates from its reference {reference:.6e} m^3 by {:.3}% (limit {:.3}%)",
+        100.0 * (volume / reference - 1.0), 100.0 * limit
+    )]
+    VolumeError {
+        /// Which body (e.g. "fluid").
+        what: String,
+        /// Current volume, m³.
+        volume: f64,
+        /// Reference volume, m³.
+        reference: f64,
+        /// Admissible relative error.
+        limit: f64,
+    },
     /// Any other model failure.
     #[error("{0}")]
     Other(String),
@@ -86,6 +123,12 @@ pub enum Quantity {
     ConstraintJacobian,
     /// Constraint acceleration right-hand side (consistent initialization).
     ConstraintAccelerationRhs,
+    /// Newton residual (right-hand side of the KKT solve).
+    Residual,
+    /// Positions of a converged step.
+    Positions,
+    /// Velocities of a converged step.
+    Velocities,
 }
 
 impl fmt::Display for Quantity {
@@ -100,6 +143,9 @@ impl fmt::Display for Quantity {
             Self::Constraints => "constraint residual C",
             Self::ConstraintJacobian => "constraint Jacobian C_q",
             Self::ConstraintAccelerationRhs => "constraint acceleration right-hand side",
+            Self::Residual => "Newton residual",
+            Self::Positions => "positions",
+            Self::Velocities => "velocities",
         };
         f.write_str(s)
     }
@@ -171,7 +217,7 @@ pub enum IntegratorError {
         rate: f64,
     },
     /// Adaptive stepping needed a step below `h_min`.
-    #[error("step size {h} s below h_min = {h_min} s at t = {t} s; last failure: {cause}")]
+    #[error("step size {h:e} s below h_min = {h_min:e} s at t = {t} s; last failure: {cause}")]
     StepTooSmall {
         /// Time at which the step failed, s.
         t: f64,
@@ -180,7 +226,7 @@ pub enum IntegratorError {
         /// Configured minimum step size, s.
         h_min: f64,
         /// Why the last attempt failed (e.g. Newton divergence, an inverted element).
-        cause: String,
+        cause: Box<IntegratorError>,
     },
     /// The sparse linear solver failed for a reason other than singularity
     /// (out of memory, index overflow).
@@ -191,6 +237,12 @@ pub enum IntegratorError {
         /// faer's error, formatted.
         message: String,
     },
+    /// A checkpoint could not be decoded or does not fit the system.
+    #[error("invalid checkpoint: {what}")]
+    Checkpoint {
+        /// What is wrong.
+        what: String,
+    },
     /// A system callback failed.
     #[error("system evaluation failed at t = {t} s: {source}")]
     System {
@@ -199,4 +251,94 @@ pub enum IntegratorError {
         /// The system's error, naming the element/constraint/body.
         source: SystemError,
     },
+}
+
+/// Classification of a failure, for sweeps and for the Python exception
+/// (`SimulationError.cause`): every stopped run names one of these.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum FailureCause {
+    /// Bad parameter or inconsistent system (nothing was integrated).
+    InvalidInput,
+    /// A finite element inverted (`J ≤ 0`).
+    InvertedElement,
+    /// Newton iterations diverged or did not converge.
+    NewtonDivergence,
+    /// A penalty contact penetrated beyond its limit.
+    ContactPenetration,
+    /// A penalty-incompressible body lost or gained volume beyond its limit.
+    VolumeError,
+    /// The KKT matrix is singular (redundant/inconsistent constraint set).
+    SingularConstraints,
+    /// A NaN/Inf appeared in a model quantity.
+    NonFinite,
+    /// The linear solver failed for another reason (memory, overflow).
+    LinearSolver,
+    /// Another model failure.
+    Model,
+}
+
+impl FailureCause {
+    /// Stable snake-case name (used in Python and in stress tables).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::InvalidInput => "invalid_input",
+            Self::InvertedElement => "inverted_element",
+            Self::NewtonDivergence => "newton_divergence",
+            Self::ContactPenetration => "contact_penetration",
+            Self::VolumeError => "volume_error",
+            Self::SingularConstraints => "singular_constraints",
+            Self::NonFinite => "non_finite",
+            Self::LinearSolver => "linear_solver",
+            Self::Model => "model",
+        }
+    }
+}
+
+impl fmt::Display for FailureCause {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl IntegratorError {
+    /// The error that actually stopped the run: for
+    /// [`StepTooSmall`](Self::StepTooSmall), the failure of the last attempt.
+    pub fn root(&self) -> &IntegratorError {
+        match self {
+            Self::StepTooSmall { cause, .. } => cause.root(),
+            other => other,
+        }
+    }
+
+    /// Classifies the root cause.
+    pub fn cause(&self) -> FailureCause {
+        match self.root() {
+            Self::InvalidParameter { .. } | Self::InvalidSystem { .. } | Self::Checkpoint { .. } => {
+                FailureCause::InvalidInput
+            }
+            Self::NonFinite { .. } => FailureCause::NonFinite,
+            Self::SingularMatrix { .. } => FailureCause::SingularConstraints,
+            Self::NewtonDivergence { .. } | Self::StepTooSmall { .. } => FailureCause::NewtonDivergence,
+            Self::LinearSolver { .. } => FailureCause::LinearSolver,
+            Self::System { source, .. } => match source {
+                SystemError::InvertedElement { .. } => FailureCause::InvertedElement,
+                SystemError::Penetration { .. } => FailureCause::ContactPenetration,
+                SystemError::VolumeError { .. } => FailureCause::VolumeError,
+                _ => FailureCause::Model,
+            },
+        }
+    }
+
+    /// Time at which the failure happened, s (`None` for invalid input).
+    pub fn time(&self) -> Option<f64> {
+        match self {
+            Self::InvalidParameter { .. } | Self::InvalidSystem { .. } | Self::Checkpoint { .. } => None,
+            Self::NonFinite { t, .. }
+            | Self::SingularMatrix { t, .. }
+            | Self::NewtonDivergence { t, .. }
+            | Self::StepTooSmall { t, .. }
+            | Self::LinearSolver { t, .. }
+            | Self::System { t, .. } => Some(*t),
+        }
+    }
 }

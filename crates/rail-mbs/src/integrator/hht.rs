@@ -8,6 +8,9 @@ use super::params::{HhtParams, JacobianPolicy, StepControl};
 use super::stats::Stats;
 use super::system::{MechanicalSystem, SparsityPattern};
 
+mod checkpoint;
+pub use checkpoint::Checkpoint;
+
 /// How the Newton matrix is refreshed during one step attempt.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum RefreshMode {
@@ -69,6 +72,9 @@ pub struct Hht<S: MechanicalSystem> {
     m: usize,
     pattern: SparsityPattern,
     mass_constant: bool,
+    /// `(row, col, value index)` of the pattern entries that can hold mass, sorted by
+    /// row: the product `M a` in the residual runs over these only.
+    mass_nz: Vec<(u32, u32, u32)>,
     // State at t_n.
     t: f64,
     q: Vec<f64>,
@@ -168,6 +174,14 @@ impl<S: MechanicalSystem> Hht<S> {
     /// onto the constraints; the first step enforces `C = 0`).
     pub fn new(system: S, t0: f64, q0: Vec<f64>, v0: Vec<f64>, params: HhtParams) -> Result<Self, IntegratorError> {
         let start = Instant::now();
+        let mut hht = Self::build(system, t0, q0, v0, params)?;
+        hht.initial_acceleration()?;
+        hht.stats.time_total += start.elapsed();
+        Ok(hht)
+    }
+
+    /// Validation, buffers and symbolic LU, without the initial-acceleration solve.
+    fn build(system: S, t0: f64, q0: Vec<f64>, v0: Vec<f64>, params: HhtParams) -> Result<Self, IntegratorError> {
         params.validate()?;
         if !t0.is_finite() {
             return Err(IntegratorError::InvalidParameter { field: "t0", value: t0, allowed: "finite" });
@@ -195,17 +209,20 @@ impl<S: MechanicalSystem> Hht<S> {
                 what: format!("constraint pattern entry {k} = ({r}, {c}) outside {m} x {n}"),
             });
         }
-        let kkt = KktSolver::new(n, m, &pattern, params.linear_residual_tol).map_err(|e| linear_error(e, t0, 0.0))?;
+        let kkt = KktSolver::new(n, m, &pattern, params.linear_residual_tol, system.linear_solver())
+            .map_err(|e| linear_error(e, t0, 0.0))?;
         let nd = pattern.dynamics.len();
         let nc = pattern.constraints.len();
         let mass_constant = system.mass_is_constant();
-        let mut hht = Self {
+        let mass_nz = mass_product_entries(&pattern, system.mass_entries());
+        Ok(Self {
             system,
             params,
             n,
             m,
             pattern,
             mass_constant,
+            mass_nz,
             t: t0,
             q: q0,
             v: v0,
@@ -234,10 +251,13 @@ impl<S: MechanicalSystem> Hht<S> {
             h_current: f64::INFINITY,
             easy_count: 0,
             stats: Stats::default(),
-        };
-        hht.initial_acceleration()?;
-        hht.stats.time_total += start.elapsed();
-        Ok(hht)
+        })
+    }
+
+    /// KKT coefficients `(1/(1+α), hγ, h²β)` of the Newton matrix for step `h`.
+    fn kkt_coeffs(&self, h: f64) -> (f64, f64, f64) {
+        let p = &self.params;
+        (1.0 / (1.0 + p.alpha), h * p.gamma(), h * h * p.beta())
     }
 
     fn eval_mass(&mut self, q_is_iterate: bool, t: f64) -> Result<(), IntegratorError> {
@@ -376,6 +396,11 @@ impl<S: MechanicalSystem> Hht<S> {
     pub fn kkt_nnz(&self) -> usize {
         self.kkt.nnz()
     }
+
+    /// Total Krylov (GMRES) iterations so far; 0 with the direct linear solver.
+    pub fn linear_iterations(&self) -> usize {
+        self.kkt.linear_iterations()
+    }
     /// The system.
     pub fn system(&self) -> &S {
         &self.system
@@ -513,7 +538,7 @@ impl<S: MechanicalSystem> Hht<S> {
                             t: self.t,
                             h: h_new,
                             h_min: p.h_min,
-                            cause: give_up(h).to_string(),
+                            cause: Box::new(give_up(h)),
                         });
                     }
                     h = h_new;
@@ -629,10 +654,10 @@ impl<S: MechanicalSystem> Hht<S> {
     fn attempt(&mut self, h: f64, mode: RefreshMode) -> Result<Outcome, IntegratorError> {
         let (n, m) = (self.n, self.m);
         let p = self.params;
-        let (alpha, beta, gamma) = (p.alpha, p.beta(), p.gamma());
+        let (alpha, beta) = (p.alpha, p.beta());
         let t1 = self.t + h;
-        let c_m = 1.0 / (1.0 + alpha);
-        let coeffs = (c_m, h * gamma, h * h * beta);
+        let coeffs = self.kkt_coeffs(h);
+        let c_m = coeffs.0;
         let c_old = alpha / (1.0 + alpha);
 
         let tic = Instant::now();
@@ -684,17 +709,27 @@ impl<S: MechanicalSystem> Hht<S> {
                 }
             }
             let mass = if self.mass_constant { &self.mass_jac } else { &self.mass_vals };
-            for (&(i, j), &mv) in self.pattern.dynamics.iter().zip(mass) {
-                r1[i] -= c_m * mv * self.a_it[j];
+            for &(i, j, k) in &self.mass_nz {
+                r1[i as usize] -= c_m * mass[k as usize] * self.a_it[j as usize];
             }
             let scale_c = 1.0 / (beta * h * h);
             for (r, c) in r2.iter_mut().zip(&self.cval) {
                 *r = -scale_c * c;
             }
+            // Finite inputs can still overflow in the sums above.
+            if let Some(index) = first_non_finite(&self.rhs) {
+                self.stats.time_assembly += tic.elapsed();
+                let err = IntegratorError::NonFinite { t: t1, what: Quantity::Residual, index };
+                if k == 0 {
+                    return Err(err);
+                }
+                return Ok(fail(iterations, e, rate, Some(err), refreshed));
+            }
+            let (r1, r2) = self.rhs.split_at(n);
             if k > 0 && norm2(r1) < p.abs_tol_acc && norm2(r2) < p.abs_tol_lambda {
                 // Residual already negligible (Chrono's absolute test).
                 self.stats.time_assembly += tic.elapsed();
-                return self.commit(h, iterations);
+                return self.commit(h, iterations, (e, rate, refreshed));
             }
 
             let refresh = refresh_next || mode == RefreshMode::EveryIteration || !self.jac_valid;
@@ -745,7 +780,7 @@ impl<S: MechanicalSystem> Hht<S> {
                 rate = e / prev_e;
             }
             if e_a < 1.0 && e_l < 1.0 || k > 0 && self.roundoff_limited(h) {
-                return self.commit(h, iterations);
+                return self.commit(h, iterations, (e, rate, refreshed));
             }
             if k > 0 {
                 let stale = mode == RefreshMode::Reuse && !refreshed;
@@ -777,9 +812,27 @@ impl<S: MechanicalSystem> Hht<S> {
         dq <= 100.0 * f64::EPSILON * inf_norm(&self.q_it)
     }
 
-    /// Accepts the iterate: Newmark update with the converged acceleration.
-    fn commit(&mut self, h: f64, iterations: usize) -> Result<Outcome, IntegratorError> {
+    /// Accepts the iterate: Newmark update with the converged acceleration, then the
+    /// system's acceptance check ([`MechanicalSystem::check_step`], e.g. contact
+    /// penetration) and a finiteness check of the new state. A rejected state is a
+    /// failed attempt (retried with a smaller step in adaptive mode).
+    fn commit(
+        &mut self,
+        h: f64,
+        iterations: usize,
+        (e, rate, refreshed): (f64, f64, bool),
+    ) -> Result<Outcome, IntegratorError> {
         self.newmark_update(h);
+        let t1 = self.t + h;
+        let rejected = |cause| Outcome::Failed { iterations, correction: e, rate, cause: Some(cause), refreshed };
+        for (x, what) in [(&self.q_it, Quantity::Positions), (&self.v_it, Quantity::Velocities)] {
+            if let Some(index) = first_non_finite(x) {
+                return Ok(rejected(IntegratorError::NonFinite { t: t1, what, index }));
+            }
+        }
+        if let Err(source) = self.system.check_step(t1, &self.q_it, &self.v_it) {
+            return Ok(rejected(IntegratorError::System { t: t1, source }));
+        }
         std::mem::swap(&mut self.q, &mut self.q_it);
         std::mem::swap(&mut self.v, &mut self.v_it);
         std::mem::swap(&mut self.a, &mut self.a_it);
@@ -788,4 +841,23 @@ impl<S: MechanicalSystem> Hht<S> {
         self.f_old_valid = false;
         Ok(Outcome::Converged { iterations })
     }
+}
+
+/// The entries used by the residual's `M a`: those the system declares as mass entries
+/// (all pattern entries if it declares none), sorted by row for memory locality.
+fn mass_product_entries(pattern: &SparsityPattern, declared: Option<Vec<usize>>) -> Vec<(u32, u32, u32)> {
+    let idx: Vec<usize> = match declared {
+        Some(v) => v.into_iter().filter(|&k| k < pattern.dynamics.len()).collect(),
+        None => (0..pattern.dynamics.len()).collect(),
+    };
+    let mut nz: Vec<(u32, u32, u32)> = idx
+        .into_iter()
+        .map(|k| {
+            let (i, j) = pattern.dynamics[k];
+            (i as u32, j as u32, k as u32)
+        })
+        .collect();
+    nz.sort_unstable();
+    nz.dedup();
+    nz
 }

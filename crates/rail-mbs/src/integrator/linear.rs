@@ -20,6 +20,7 @@ use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::{Pair, SparseColMat, SymbolicSparseColMat};
 
 use super::error::KktIndex;
+use super::iterative::{BlockJacobi, CsrView, Gmres, IterativeParams, LinearSolverKind};
 use super::system::SparsityPattern;
 
 /// Why a factorization or solve failed (converted to an
@@ -46,8 +47,7 @@ pub(crate) struct KktSolver {
     dyn_pos: Vec<usize>,
     /// CSC value positions of each `C_q` entry: `(n + k, j)` and `(j, n + k)`.
     cq_pos: Vec<(usize, usize)>,
-    symbolic: SymbolicLu<usize>,
-    lu: Option<Lu<usize, f64>>,
+    backend: Backend,
     /// Copy of the right-hand side for the residual check.
     rhs_copy: Vec<f64>,
     /// Residual / refinement buffer.
@@ -58,10 +58,31 @@ pub(crate) struct KktSolver {
     a_max: f64,
 }
 
+/// The factorization behind [`KktSolver`].
+enum Backend {
+    /// Sparse LU: symbolic factorization once, numeric LU per refresh.
+    Direct { symbolic: SymbolicLu<usize>, lu: Option<Lu<usize, f64>> },
+    /// GMRES with block Jacobi: "factorizing" inverts the diagonal blocks.
+    Iterative {
+        params: IterativeParams,
+        csr: CsrView,
+        prec: BlockJacobi,
+        gmres: Box<Gmres>,
+        factored: bool,
+        iterations: usize,
+    },
+}
+
 impl KktSolver {
-    /// Builds the pattern and the symbolic LU. Pattern entries must already be
-    /// validated against `n` and `m`.
-    pub(crate) fn new(n: usize, m: usize, pattern: &SparsityPattern, residual_tol: f64) -> Result<Self, LinearFailure> {
+    /// Builds the pattern and the symbolic LU (direct) or the CSR view (iterative).
+    /// Pattern entries must already be validated against `n` and `m`.
+    pub(crate) fn new(
+        n: usize,
+        m: usize,
+        pattern: &SparsityPattern,
+        residual_tol: f64,
+        kind: LinearSolverKind,
+    ) -> Result<Self, LinearFailure> {
         let dim = n + m;
         let mut pairs: Vec<Pair<usize, usize>> =
             Vec::with_capacity(pattern.dynamics.len() + n + 2 * pattern.constraints.len());
@@ -83,16 +104,40 @@ impl KktSolver {
         let cq_pos = pattern.constraints.iter().map(|&(k, j)| (pos(n + k, j), pos(j, n + k))).collect();
         let nnz = symbolic.row_idx().len();
         let matrix = SparseColMat::new(symbolic, vec![0.0; nnz]);
-        let symbolic_lu =
-            SymbolicLu::try_new(matrix.symbolic()).map_err(|e| LinearFailure::Generic(format!("{e:?}")))?;
+        let backend = match kind {
+            LinearSolverKind::Direct => Backend::Direct {
+                symbolic: SymbolicLu::try_new(matrix.symbolic())
+                    .map_err(|e| LinearFailure::Generic(format!("{e:?}")))?,
+                lu: None,
+            },
+            LinearSolverKind::Iterative(params) => {
+                if m > 0 {
+                    return Err(LinearFailure::Generic(format!(
+                        "the iterative linear solver needs an unconstrained system; this one has {m} constraints \
+                         (use LinearSolverKind::Direct)"
+                    )));
+                }
+                params.validate().map_err(|(field, value, allowed)| {
+                    LinearFailure::Generic(format!("invalid parameter `{field}` = {value}: allowed {allowed}"))
+                })?;
+                let sym = matrix.symbolic();
+                Backend::Iterative {
+                    params,
+                    csr: CsrView::from_csc(dim, sym.col_ptr(), sym.row_idx()),
+                    prec: BlockJacobi::new(dim, params.block),
+                    gmres: Box::new(Gmres::new(dim, params.restart.min(dim.max(1)))),
+                    factored: false,
+                    iterations: 0,
+                }
+            }
+        };
         Ok(Self {
             n,
             m,
             matrix,
             dyn_pos,
             cq_pos,
-            symbolic: symbolic_lu,
-            lu: None,
+            backend,
             rhs_copy: vec![0.0; dim],
             work: vec![0.0; dim],
             residual_tol,
@@ -103,6 +148,14 @@ impl KktSolver {
     /// Number of structural non-zeros of the KKT matrix.
     pub(crate) fn nnz(&self) -> usize {
         self.matrix.val().len()
+    }
+
+    /// Total Krylov iterations of the iterative backend so far (0 for the direct one).
+    pub(crate) fn linear_iterations(&self) -> usize {
+        match &self.backend {
+            Backend::Direct { .. } => 0,
+            Backend::Iterative { iterations, .. } => *iterations,
+        }
     }
 
     /// Writes `c_m M − c_v Dv − c_q Dq` and `C_q`, `C_qᵀ` into the matrix values.
@@ -127,19 +180,31 @@ impl KktSolver {
 
     /// Numeric LU of the current values, reusing the symbolic factorization.
     pub(crate) fn factorize(&mut self) -> Result<(), LinearFailure> {
-        self.lu = None;
+        match &mut self.backend {
+            Backend::Direct { lu, .. } => *lu = None,
+            Backend::Iterative { factored, .. } => *factored = false,
+        }
         if self.matrix.val().iter().any(|v| !v.is_finite()) {
             return Err(LinearFailure::Numeric(None));
         }
         self.a_max = inf_norm(self.matrix.val());
+        let (symbolic, lu_slot) = match &mut self.backend {
+            Backend::Direct { symbolic, lu } => (symbolic, lu),
+            Backend::Iterative { csr, prec, factored, .. } => {
+                csr.gather(self.matrix.val());
+                prec.factor(csr).map_err(LinearFailure::NoPivot)?;
+                *factored = true;
+                return Ok(());
+            }
+        };
         // faer 0.24 can panic on some zero pivots (faer-rs issue #232); turn that into
         // an error instead of unwinding through the integrator.
         let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            Lu::try_new_with_symbolic(self.symbolic.clone(), self.matrix.as_ref())
+            Lu::try_new_with_symbolic(symbolic.clone(), self.matrix.as_ref())
         }));
         match result {
             Ok(Ok(lu)) => {
-                self.lu = Some(lu);
+                *lu_slot = Some(lu);
                 Ok(())
             }
             Ok(Err(LuError::SymbolicSingular { index })) => Err(LinearFailure::NoPivot(index)),
@@ -153,8 +218,21 @@ impl KktSolver {
     /// refinement if the residual is too large.
     pub(crate) fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearFailure> {
         let dim = self.n + self.m;
-        let Some(lu) = self.lu.as_ref() else {
-            return Err(LinearFailure::Numeric(None));
+        let lu = match &mut self.backend {
+            Backend::Direct { lu: Some(lu), .. } => lu,
+            Backend::Direct { lu: None, .. } | Backend::Iterative { factored: false, .. } => {
+                return Err(LinearFailure::Numeric(None));
+            }
+            Backend::Iterative { params, csr, prec, gmres, iterations, .. } => {
+                self.rhs_copy.copy_from_slice(rhs);
+                rhs.fill(0.0);
+                let report = gmres.solve(csr, prec, &self.rhs_copy, rhs, params.rel_tol, params.max_iterations);
+                *iterations += report.iterations;
+                if let Some(i) = rhs.iter().position(|v| !v.is_finite()) {
+                    return Err(LinearFailure::Numeric(Some(KktIndex::from_raw(i, self.n))));
+                }
+                return if report.converged { Ok(()) } else { Err(LinearFailure::Numeric(None)) };
+            }
         };
         self.rhs_copy.copy_from_slice(rhs);
         lu.solve_in_place(MatMut::from_column_major_slice_mut(rhs, dim, 1));
@@ -206,7 +284,7 @@ mod tests {
             dynamics: vec![(0, 0), (1, 1), (2, 2), (0, 1), (1, 0), (2, 1), (2, 2)],
             constraints: vec![(0, 0), (0, 2)],
         };
-        let mut kkt = KktSolver::new(3, 1, &pattern, 1e-12).unwrap();
+        let mut kkt = KktSolver::new(3, 1, &pattern, 1e-12, LinearSolverKind::Direct).unwrap();
         let mass = [2.0, 3.0, 4.0, 0.0, 0.0, 0.0, 0.0];
         let dq = [-1.0, -1.0, -1.0, 0.5, 0.5, 0.25, -1.0];
         let dv = [-0.1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
@@ -232,11 +310,45 @@ mod tests {
         assert_eq!(kkt.nnz(), 3 + 3 + 4);
     }
 
+    /// The iterative backend solves the same unconstrained system as the direct one, and
+    /// refuses a constrained one.
+    #[test]
+    fn iterative_backend_matches_direct() {
+        let n: usize = 30;
+        let mut dynamics = Vec::new();
+        for i in 0..n {
+            for j in i.saturating_sub(2)..(i + 3).min(n) {
+                dynamics.push((i, j));
+            }
+        }
+        let pattern = SparsityPattern { dynamics, constraints: vec![] };
+        let mass: Vec<f64> = pattern.dynamics.iter().map(|&(i, j)| if i == j { 2.0 } else { 0.3 }).collect();
+        let dq: Vec<f64> = pattern.dynamics.iter().map(|&(i, j)| -(((i * 7 + j * 3) % 5) as f64)).collect();
+        let dv: Vec<f64> = pattern.dynamics.iter().map(|&(i, j)| if i == j { -0.5 } else { 0.05 }).collect();
+        let coeffs = (1.0, 0.1, 0.01);
+        let b: Vec<f64> = (0..n).map(|i| (i as f64).cos()).collect();
+        let mut x = [b.clone(), b.clone()];
+        for (kind, x) in [LinearSolverKind::Direct, LinearSolverKind::Iterative(IterativeParams::default())]
+            .into_iter()
+            .zip(x.iter_mut())
+        {
+            let mut kkt = KktSolver::new(n, 0, &pattern, 1e-12, kind).unwrap();
+            kkt.assemble(&mass, &dq, &dv, &[], coeffs);
+            kkt.factorize().unwrap();
+            kkt.solve_in_place(x).unwrap();
+        }
+        let err = x[0].iter().zip(&x[1]).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        assert!(err < 1e-9, "direct vs iterative: {err}");
+        let constrained = SparsityPattern { dynamics: vec![(0, 0)], constraints: vec![(0, 0)] };
+        let kind = LinearSolverKind::Iterative(IterativeParams::default());
+        assert!(matches!(KktSolver::new(1, 1, &constrained, 1e-12, kind), Err(LinearFailure::Generic(_))));
+    }
+
     #[test]
     fn zero_constraint_row_is_structurally_singular() {
         let pattern = SparsityPattern { dynamics: vec![(0, 0), (1, 1)], constraints: vec![(0, 0)] };
         // Constraint 1 has no Jacobian entries.
-        let mut kkt = KktSolver::new(2, 2, &pattern, 1e-12).unwrap();
+        let mut kkt = KktSolver::new(2, 2, &pattern, 1e-12, LinearSolverKind::Direct).unwrap();
         kkt.assemble(&[1.0, 1.0], &[0.0; 2], &[0.0; 2], &[1.0], (1.0, 0.0, 0.0));
         assert!(matches!(kkt.factorize(), Err(LinearFailure::NoPivot(_))));
     }

@@ -130,13 +130,17 @@
 
 mod error;
 mod hht;
+mod iterative;
+mod journal;
 mod linear;
 mod params;
 mod stats;
 mod system;
 
-pub use error::{IntegratorError, KktIndex, Quantity, SystemError};
-pub use hht::{Hht, StateRef, StepInfo};
+pub use error::{FailureCause, IntegratorError, KktIndex, Quantity, SystemError};
+pub use hht::{Checkpoint, Hht, StateRef, StepInfo};
+pub use iterative::{IterativeParams, LinearSolverKind};
+pub use journal::{CheckpointFile, Journal, read_journal};
 pub use params::{AdaptiveParams, HhtParams, JacobianPolicy, StepControl};
 pub use stats::Stats;
 pub use system::{MechanicalSystem, SparsityPattern};

@@ -1,6 +1,7 @@
 //! The [`MechanicalSystem`] trait: what the integrator needs from a model.
 
 use super::error::SystemError;
+use super::iterative::LinearSolverKind;
 
 /// Fixed sparsity pattern of a [`MechanicalSystem`], declared once.
 ///
@@ -75,6 +76,23 @@ pub trait MechanicalSystem {
         false
     }
 
+    /// How the integrator should solve this system's Newton matrix. Called once, when
+    /// the integrator is built. Default: sparse LU ([`LinearSolverKind::Direct`]).
+    /// Large unconstrained systems (a fluid mesh in a prescribed-motion tank) may
+    /// return [`LinearSolverKind::Iterative`], whose cost grows linearly with size.
+    fn linear_solver(&self) -> LinearSolverKind {
+        LinearSolverKind::Direct
+    }
+
+    /// Optional: the indices into `pattern().dynamics` where [`mass`] can write a
+    /// non-zero value (at any `q`). The integrator then forms `M a` over these entries
+    /// only. Default `None`: every pattern entry.
+    ///
+    /// [`mass`]: MechanicalSystem::mass
+    fn mass_entries(&self) -> Option<Vec<usize>> {
+        None
+    }
+
     /// Mass-matrix values at `q`, in `pattern().dynamics` order, kg (or kg·m² …).
     fn mass(&mut self, q: &[f64], values: &mut [f64]) -> Result<(), SystemError>;
 
@@ -136,5 +154,15 @@ pub trait MechanicalSystem {
     ) -> Result<bool, SystemError> {
         let _ = (t, q, v, out);
         Ok(false)
+    }
+
+    /// Optional acceptance check of a converged step at `(t, q, v)`, before it is
+    /// committed (e.g. contact penetration beyond a limit, see
+    /// [`SystemError::Penetration`]). An error rejects the step: in adaptive mode it is
+    /// retried with a smaller `h`, otherwise the run stops with this error. Default:
+    /// accept.
+    fn check_step(&mut self, t: f64, q: &[f64], v: &[f64]) -> Result<(), SystemError> {
+        let _ = (t, q, v);
+        Ok(())
     }
 }

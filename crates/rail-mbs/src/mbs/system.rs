@@ -344,6 +344,15 @@ impl MechanicalSystem for Multibody {
         self.build_layout().0
     }
 
+    fn mass_entries(&self) -> Option<Vec<usize>> {
+        let layout = self.layout.clone().unwrap_or_else(|| std::sync::Arc::new(self.build_layout().1));
+        Some(
+            (0..self.bodies.len())
+                .flat_map(|b| (0..49).map(|k| layout.blocks[&(b, b)] + k).collect::<Vec<_>>())
+                .collect(),
+        )
+    }
+
     fn mass(&mut self, q: &[f64], values: &mut [f64]) -> Result<(), SystemError> {
         let layout = self.layout();
         for (b, body) in self.bodies.iter().enumerate() {

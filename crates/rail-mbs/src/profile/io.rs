@@ -6,14 +6,28 @@
 use super::{Profile, ProfileError};
 use std::path::Path;
 
+/// Reads a file as UTF-8 text; bytes that are not UTF-8 are a [`ProfileError::Parse`]
+/// naming the line (malformed content, not an I/O failure).
+fn read_text(path: &Path) -> Result<String, ProfileError> {
+    let bytes = std::fs::read(path).map_err(|e| ProfileError::Io { path: path.display().to_string(), source: e })?;
+    String::from_utf8(bytes).map_err(|e| {
+        let offset = e.utf8_error().valid_up_to();
+        let bytes = e.as_bytes();
+        ProfileError::Parse {
+            file: path.display().to_string(),
+            line: 1 + bytes[..offset].iter().filter(|&&b| b == b'\n').count(),
+            message: format!("not UTF-8 text (invalid byte 0x{:02x} at offset {offset})", bytes[offset]),
+        }
+    })
+}
+
 /// Reads a two-column text file of `y z` pairs (whitespace, comma or semicolon
 /// separated). Empty lines and lines starting with `#`, `%`, `!` or `//` are skipped; a
 /// trailing third column (weight) is ignored. Values are returned as written (no unit
 /// or sign conversion).
 pub fn read_two_column(path: impl AsRef<Path>) -> Result<Vec<(f64, f64)>, ProfileError> {
     let path = path.as_ref();
-    let text =
-        std::fs::read_to_string(path).map_err(|e| ProfileError::Io { path: path.display().to_string(), source: e })?;
+    let text = read_text(path)?;
     parse_two_column(&text, &path.display().to_string())
 }
 
@@ -122,8 +136,7 @@ impl SimpackProfile {
 /// Reads a SIMPACK `.prr`/`.prw` profile file.
 pub fn read_simpack(path: impl AsRef<Path>) -> Result<SimpackProfile, ProfileError> {
     let path = path.as_ref();
-    let text =
-        std::fs::read_to_string(path).map_err(|e| ProfileError::Io { path: path.display().to_string(), source: e })?;
+    let text = read_text(path)?;
     let name = path.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_else(|| path.display().to_string());
     parse_simpack(&text, &name)
 }

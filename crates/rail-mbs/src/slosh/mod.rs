@@ -11,12 +11,13 @@ pub mod system;
 pub mod validate;
 
 pub use modes::{LinearModes, linear_modes};
-pub use motion::{PiecewiseAcceleration, PrescribedMotion, TankState};
+pub use motion::{PiecewiseAcceleration, PrescribedMotion, TankFrameInput, TankFrameSample, TankState};
 pub use system::{SloshFrame, SloshSystem};
 
 use nalgebra::Vector3;
 
-use crate::integrator::{Hht, HhtParams, IntegratorError, Stats};
+use crate::integrator::{Hht, HhtParams, IntegratorError, Journal, Stats};
+use crate::vehicle::{Observer, Progress};
 
 /// Time series recorded by a slosh run. Loads are the force and moment the fluid exerts on
 /// the tank (through wall and bulkhead contact), moments about the tank origin.
@@ -44,6 +45,49 @@ pub struct SloshRecord {
     pub newton_iterations: Vec<usize>,
     /// Largest wall penetration (m).
     pub max_penetration: Vec<f64>,
+}
+
+impl SloshRecord {
+    /// Column names of [`SloshRecord::row`] (vectors as `_x`, `_y`, `_z`).
+    pub const COLUMNS: [&'static str; 21] = [
+        "t",
+        "force_tank_x",
+        "force_tank_y",
+        "force_tank_z",
+        "moment_tank_x",
+        "moment_tank_y",
+        "moment_tank_z",
+        "force_global_x",
+        "force_global_y",
+        "force_global_z",
+        "moment_global_x",
+        "moment_global_y",
+        "moment_global_z",
+        "com_tank_x",
+        "com_tank_y",
+        "com_tank_z",
+        "volume",
+        "kinetic_energy",
+        "potential_energy",
+        "newton_iterations",
+        "max_penetration",
+    ];
+
+    /// Sample `i` as one row of [`SloshRecord::COLUMNS`].
+    pub fn row(&self, i: usize) -> Vec<f64> {
+        let mut r = vec![self.t[i]];
+        for v in [&self.force_tank, &self.moment_tank, &self.force_global, &self.moment_global, &self.com_tank] {
+            r.extend_from_slice(&v[i]);
+        }
+        r.extend([
+            self.volume[i],
+            self.kinetic_energy[i],
+            self.potential_energy[i],
+            self.newton_iterations[i] as f64,
+            self.max_penetration[i],
+        ]);
+        r
+    }
 }
 
 /// A slosh run: the integrator, its system and the record.
@@ -81,14 +125,54 @@ impl SloshRun {
 
     /// Integrate to `t_end` with steps of (at most) `h`, recording every step.
     pub fn run_to(&mut self, t_end: f64, h: f64) -> Result<(), Box<SloshFailure>> {
+        self.run_to_observed(t_end, h, &mut |_| true)
+    }
+
+    /// [`SloshRun::run_to`] calling `observe` after every accepted step; the run stops
+    /// (with [`crate::vehicle::stopped_by_observer`]) when it returns `false`.
+    pub fn run_to_observed(&mut self, t_end: f64, h: f64, observe: Observer<'_>) -> Result<(), Box<SloshFailure>> {
         while t_end - self.hht.t() > 1e-12 * (1.0 + t_end.abs()) {
             let h_step = h.min(t_end - self.hht.t());
             match self.hht.step(h_step) {
                 Ok(info) => self.record_state(info.iterations),
                 Err(error) => return Err(Box::new(SloshFailure { error, record: self.record.clone() })),
             }
+            if !observe(&Progress::of(&self.hht, t_end)) {
+                let error = crate::vehicle::stopped_by_observer(self.hht.t());
+                return Err(Box::new(SloshFailure { error, record: self.record.clone() }));
+            }
         }
         Ok(())
+    }
+
+    /// [`SloshRun::run_to_observed`] that also appends every recorded sample (and any
+    /// not yet written) to `journal` (columns [`SloshRecord::COLUMNS`], created by the
+    /// caller), flushed as the journal says: an interrupted run keeps every sample already
+    /// written (read back with [`crate::integrator::read_journal`]). Results are the same
+    /// as without the journal.
+    pub fn run_to_journaled(
+        &mut self,
+        t_end: f64,
+        h: f64,
+        observe: Observer<'_>,
+        journal: &mut Journal,
+    ) -> Result<(), Box<SloshFailure>> {
+        let fail = |run: &Self, error| Box::new(SloshFailure { error, record: run.record.clone() });
+        while journal.rows() < self.record.t.len() {
+            journal.append(&self.record.row(journal.rows())).map_err(|e| fail(self, e))?;
+        }
+        while t_end - self.hht.t() > 1e-12 * (1.0 + t_end.abs()) {
+            let h_step = h.min(t_end - self.hht.t());
+            match self.hht.step(h_step) {
+                Ok(info) => self.record_state(info.iterations),
+                Err(error) => return Err(fail(self, error)),
+            }
+            journal.append(&self.record.row(self.record.t.len() - 1)).map_err(|e| fail(self, e))?;
+            if !observe(&Progress::of(&self.hht, t_end)) {
+                return Err(fail(self, crate::vehicle::stopped_by_observer(self.hht.t())));
+            }
+        }
+        journal.flush().map_err(|e| fail(self, e))
     }
 
     /// Integrator statistics.

@@ -160,6 +160,81 @@ impl PrescribedMotion {
     }
 }
 
+/// Tank motion as seen in the tank frame at one instant (seed 003's co-simulation
+/// interface, appendix C eq. 7.40): all vectors in tank axes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TankFrameSample {
+    /// Acceleration of the tank origin R̈, tank components (m/s²).
+    pub acceleration: [f64; 3],
+    /// Angular velocity ω of the tank, tank components (rad/s).
+    pub angular_velocity: [f64; 3],
+    /// Angular acceleration ω̇ of the tank, tank components (rad/s²).
+    pub angular_acceleration: [f64; 3],
+    /// Gravity vector (direction × g), tank components (m/s²).
+    pub gravity: [f64; 3],
+}
+
+impl TankFrameSample {
+    /// A tank at rest, gravity `g` along −z of the tank.
+    pub fn at_rest(g: f64) -> Self {
+        Self {
+            acceleration: [0.0; 3],
+            angular_velocity: [0.0; 3],
+            angular_acceleration: [0.0; 3],
+            gravity: [0.0, 0.0, -g],
+        }
+    }
+
+    /// `(1 − s) self + s other`, component-wise.
+    pub fn lerp(&self, other: &Self, s: f64) -> Self {
+        let l = |a: [f64; 3], b: [f64; 3]| std::array::from_fn(|i| a[i] + s * (b[i] - a[i]));
+        Self {
+            acceleration: l(self.acceleration, other.acceleration),
+            angular_velocity: l(self.angular_velocity, other.angular_velocity),
+            angular_acceleration: l(self.angular_acceleration, other.angular_acceleration),
+            gravity: l(self.gravity, other.gravity),
+        }
+    }
+
+    /// Whether every component is finite.
+    pub fn is_finite(&self) -> bool {
+        [self.acceleration, self.angular_velocity, self.angular_acceleration, self.gravity]
+            .iter()
+            .all(|v| v.iter().all(|x| x.is_finite()))
+    }
+}
+
+/// Tank-frame motion over a time window [t0, t1], linearly interpolated between the samples
+/// at its ends (constant outside). Used by [`SloshSystem`](super::SloshSystem) in the
+/// tank-frame formulation instead of its [`PrescribedMotion`] when set (co-simulation).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TankFrameInput {
+    /// Window start (s).
+    pub t0: f64,
+    /// Window end (s), ≥ t0.
+    pub t1: f64,
+    /// Sample at t0.
+    pub start: TankFrameSample,
+    /// Sample at t1.
+    pub end: TankFrameSample,
+}
+
+impl TankFrameInput {
+    /// A constant input for all time.
+    pub fn constant(sample: TankFrameSample) -> Self {
+        Self { t0: 0.0, t1: 0.0, start: sample, end: sample }
+    }
+
+    /// The interpolated sample at t.
+    pub fn at(&self, t: f64) -> TankFrameSample {
+        if self.t1 <= self.t0 {
+            return if t < self.t0 { self.start } else { self.end };
+        }
+        let s = ((t - self.t0) / (self.t1 - self.t0)).clamp(0.0, 1.0);
+        if s == 1.0 { self.end } else { self.start.lerp(&self.end, s) }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -21,8 +21,8 @@ use ancf_core::error::AncfError;
 use ancf_core::shape::N_SHAPE;
 use nalgebra::Vector3;
 
-use super::motion::PrescribedMotion;
-use crate::integrator::{MechanicalSystem, SparsityPattern, SystemError};
+use super::motion::{PrescribedMotion, TankFrameInput};
+use crate::integrator::{LinearSolverKind, MechanicalSystem, SparsityPattern, SystemError};
 
 /// Which frame the fluid coordinates are written in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -46,17 +46,36 @@ pub struct SloshSystem {
     pub gravity: [f64; 3],
     /// Formulation.
     pub frame: SloshFrame,
+    /// How the Newton matrix is solved; read when the integrator is built. Default
+    /// sparse LU; [`LinearSolverKind::Iterative`] scales linearly to large meshes.
+    pub linear_solver: LinearSolverKind,
+    /// Largest admissible wall/bulkhead penetration (m), checked on every converged step
+    /// ([`SystemError::Penetration`]). Default: [`PENETRATION_LIMIT_FACTOR`] × the
+    /// smallest element edge.
+    pub penetration_limit: f64,
+    /// Admissible relative volume error of the fluid, checked on every converged step
+    /// ([`SystemError::VolumeError`]). Default 0.01.
+    pub volume_tolerance: f64,
+    /// Volume of the reference configuration, m³.
+    pub reference_volume: f64,
+    /// Tank-frame formulation only: when set, the pseudo-forces and the tank-frame gravity
+    /// come from these sampled inputs instead of [`motion`](Self::motion) (co-simulation,
+    /// [`crate::cosim`]). `None` from [`SloshSystem::new`].
+    pub tank_input: Option<TankFrameInput>,
     pattern: Vec<(usize, usize)>,
     blocks: HashMap<(usize, usize), usize>,
     element_blocks: Vec<[usize; 64]>,
     point_jac: Vec<PointJacobian>,
 }
 
+/// Default penetration limit relative to the smallest element edge: a contact point
+/// half an element deep in the wall means the penalty contact no longer represents
+/// the wall.
+pub const PENETRATION_LIMIT_FACTOR: f64 = 0.5;
+
 fn sys_err(e: AncfError) -> SystemError {
     match e {
-        AncfError::InvertedElement { element, point, j } => {
-            SystemError::Element { index: element, reason: format!("inverted: J = {j:.3e} at point {point}") }
-        }
+        AncfError::InvertedElement { element, point, j } => SystemError::InvertedElement { element, point, j },
         AncfError::NonFinite { element, what } => SystemError::Element { index: element, reason: what },
         other => SystemError::Other(other.to_string()),
     }
@@ -124,7 +143,24 @@ impl SloshSystem {
             }
             element_blocks.push(eb);
         }
-        Ok(Self { body, contact, motion, gravity, frame, pattern, blocks, element_blocks, point_jac: Vec::new() })
+        let min_edge = body.elements.iter().flat_map(|e| e.lengths).fold(f64::INFINITY, f64::min);
+        let reference_volume = body.volume(&body.reference_coordinates());
+        Ok(Self {
+            penetration_limit: PENETRATION_LIMIT_FACTOR * min_edge,
+            volume_tolerance: 0.01,
+            reference_volume,
+            body,
+            contact,
+            motion,
+            gravity,
+            frame,
+            tank_input: None,
+            linear_solver: LinearSolverKind::Direct,
+            pattern,
+            blocks,
+            element_blocks,
+            point_jac: Vec::new(),
+        })
     }
 
     /// Tank kinematics seen by the contact at time t (identity in the tank frame).
@@ -162,6 +198,15 @@ impl SloshSystem {
 
     /// Tank-frame gravity, linear acceleration, ω and ω̇ (tank components) at t.
     fn tank_frame_terms(&self, t: f64) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>, Vector3<f64>) {
+        if let Some(input) = &self.tank_input {
+            let s = input.at(t);
+            return (
+                Vector3::from(s.gravity),
+                Vector3::from(s.acceleration),
+                Vector3::from(s.angular_velocity),
+                Vector3::from(s.angular_acceleration),
+            );
+        }
         let s = self.motion.state(t);
         let at = s.kinematics.rotation.transpose();
         (
@@ -206,12 +251,27 @@ impl MechanicalSystem for SloshSystem {
         self.body.n_coords()
     }
 
+    fn linear_solver(&self) -> LinearSolverKind {
+        self.linear_solver
+    }
+
     fn pattern(&self) -> SparsityPattern {
         SparsityPattern { dynamics: self.pattern.clone(), constraints: Vec::new() }
     }
 
     fn mass_is_constant(&self) -> bool {
         true
+    }
+
+    fn mass_entries(&self) -> Option<Vec<usize>> {
+        let m = self.body.scalar_mass().as_ref();
+        let mut idx = Vec::with_capacity(3 * m.compute_nnz());
+        for j in 0..m.ncols() {
+            for i in m.row_idx_of_col(j) {
+                idx.extend((0..3).map(|k| self.value_index(3 * i + k, 3 * j + k)));
+            }
+        }
+        Some(idx)
     }
 
     fn mass(&mut self, _q: &[f64], values: &mut [f64]) -> Result<(), SystemError> {
@@ -261,6 +321,28 @@ impl MechanicalSystem for SloshSystem {
         self.contact.forces(&self.body, &kin, q, v, out, None);
         if let Some(i) = out.iter().position(|x| !x.is_finite()) {
             return Err(SystemError::Other(format!("non-finite generalized force at coordinate {i}")));
+        }
+        Ok(())
+    }
+
+    fn check_step(&mut self, t: f64, q: &[f64], v: &[f64]) -> Result<(), SystemError> {
+        let load = self.contact_load(t, q, v);
+        if load.max_penetration > self.penetration_limit {
+            return Err(SystemError::Penetration {
+                contact: format!("fluid-wall contact ({} points active)", load.active),
+                depth: load.max_penetration,
+                limit: self.penetration_limit,
+            });
+        }
+        let volume = self.body.volume(q);
+        let error = (volume / self.reference_volume - 1.0).abs();
+        if error.is_nan() || error > self.volume_tolerance {
+            return Err(SystemError::VolumeError {
+                what: "fluid".into(),
+                volume,
+                reference: self.reference_volume,
+                limit: self.volume_tolerance,
+            });
         }
         Ok(())
     }

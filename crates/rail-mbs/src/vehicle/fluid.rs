@@ -79,10 +79,7 @@ pub struct FluidVehicle {
 
 fn sys_err(e: AncfError) -> SystemError {
     match e {
-        AncfError::InvertedElement { element, point, j } => SystemError::Element {
-            index: element,
-            reason: format!("fluid element inverted: J = {j:.3e} at point {point}"),
-        },
+        AncfError::InvertedElement { element, point, j } => SystemError::InvertedElement { element, point, j },
         AncfError::NonFinite { element, what } => SystemError::Element { index: element, reason: what },
         other => SystemError::Other(other.to_string()),
     }
@@ -230,6 +227,14 @@ impl MechanicalSystem for FluidVehicle {
         self.build_pattern().0
     }
 
+    fn mass_entries(&self) -> Option<Vec<usize>> {
+        let mut idx = self.mb.mass_entries()?;
+        for lay in &self.layouts {
+            idx.extend(lay.mass_entries.iter().map(|&(i, _)| i));
+        }
+        Some(idx)
+    }
+
     fn mass(&mut self, q: &[f64], values: &mut [f64]) -> Result<(), SystemError> {
         let nr = self.n_rigid;
         self.mb.mass(&q[..nr], &mut values[..self.mb_entries])?;
@@ -268,6 +273,33 @@ impl MechanicalSystem for FluidVehicle {
         }
         if let Some(i) = out.iter().position(|x| !x.is_finite()) {
             return Err(SystemError::Other(format!("non-finite generalized force at coordinate {i}")));
+        }
+        Ok(())
+    }
+
+    /// Rejects a step on which a fluid's volume error exceeds 1 % or a fluid penetrates
+    /// its tank wall deeper than half its smallest element edge (as `SloshSystem`).
+    fn check_step(&mut self, _t: f64, q: &[f64], v: &[f64]) -> Result<(), SystemError> {
+        let nr = self.n_rigid;
+        for (k, f) in self.fluids.iter().enumerate() {
+            let (e, ed) = (self.fluid_slice(k, q), self.fluid_slice(k, v));
+            let (volume, reference) = (f.body.volume(e), f.body.reference_volume());
+            let error = (volume / reference - 1.0).abs();
+            if error.is_nan() || error > 0.01 {
+                return Err(SystemError::VolumeError { what: format!("fluid {k}"), volume, reference, limit: 0.01 });
+            }
+            let tank = self.mb.state(Some(f.tank), &q[..nr], &v[..nr]);
+            let mut scratch = vec![0.0; e.len()];
+            let load = f.contact.forces(&f.body, &tank_kinematics(&tank), e, ed, &mut scratch, None);
+            let min_edge = f.body.elements.iter().flat_map(|el| el.lengths).fold(f64::INFINITY, f64::min);
+            let limit = crate::slosh::system::PENETRATION_LIMIT_FACTOR * min_edge;
+            if load.max_penetration > limit {
+                return Err(SystemError::Penetration {
+                    contact: format!("fluid {k} - tank wall ({} points active)", load.active),
+                    depth: load.max_penetration,
+                    limit,
+                });
+            }
         }
         Ok(())
     }
@@ -409,7 +441,7 @@ use ancf_core::mesh::{CylinderTankSpec, cylinder_tank, cylinder_tank_compartment
 use ancf_core::tank::{Bulkhead, TankGeometry, TankShape};
 use std::time::Instant;
 
-use super::run::{TrainRecord, TrainScenario, build_train, record_sample, step_and_record};
+use super::run::{Observer, TrainRecord, TrainScenario, build_train, record_sample, step_and_record};
 use super::tank_car::CarBodies;
 use crate::integrator::{Hht, IntegratorError};
 
@@ -474,6 +506,9 @@ pub struct FluidTrainRecord {
     pub fluid_mass: f64,
     /// Fluid elements per car.
     pub elements: usize,
+    /// Element-node table of each car's fluid mesh (node order A..H, docs/frames.md), for
+    /// writing the snapshots as hexahedra.
+    pub connectivity: Vec<[usize; 8]>,
 }
 
 /// A fluid run that stopped early: why, and what was recorded.
@@ -556,10 +591,20 @@ pub fn run_fluid_train(
     sc: &TrainScenario,
     cargo: &FluidCargo,
 ) -> Result<Result<FluidTrainRecord, Box<FluidTrainFailure>>, AncfError> {
+    run_fluid_train_observed(sc, cargo, &mut |_| true)
+}
+
+/// [`run_fluid_train`] with an [`Observer`] of its progress.
+pub fn run_fluid_train_observed(
+    sc: &TrainScenario,
+    cargo: &FluidCargo,
+    observe: Observer<'_>,
+) -> Result<Result<FluidTrainRecord, Box<FluidTrainFailure>>, AncfError> {
     let (sys, cars, couplers) = build_fluid_train(sc, cargo)?;
     let mut rec = FluidTrainRecord {
         fluid_mass: sys.fluids[0].body.total_mass(),
         elements: sys.fluids[0].body.mesh.n_elements(),
+        connectivity: sys.fluids[0].body.mesh.elements.clone(),
         ..Default::default()
     };
     rec.train.static_wheel_load = cars[0].static_wheel_load;
@@ -583,7 +628,7 @@ pub fn run_fluid_train(
         Err(error) => return Ok(Err(Box::new(FluidTrainFailure { error, record: finish(None, rec) }))),
     };
     let mut hints: Vec<f64> = cars.iter().flat_map(|c| [c.station; 4]).collect();
-    let result = step_and_record(&mut hht, sc, |hht, k| {
+    let result = step_and_record(&mut hht, sc, observe, |hht, k| {
         let (t, q, v) = (hht.t(), hht.q().to_vec(), hht.v().to_vec());
         let sys = hht.system_mut();
         record_sample(&mut sys.mb, (t, &q[..nr], &v[..nr]), &sc.track, &cars, &couplers, &mut hints, &mut rec.train)?;

@@ -41,8 +41,12 @@ pub mod validate;
 
 pub use fluid::{
     FluidCargo, FluidTrainFailure, FluidTrainRecord, FluidVehicle, TankFluid, build_fluid_train, run_fluid_train,
+    run_fluid_train_observed,
 };
-pub use run::{BrakeScope, TrainFailure, TrainRecord, TrainScenario, build_train, run_train};
+pub use run::{
+    BrakeScope, Observer, Progress, TrainFailure, TrainRecord, TrainScenario, build_train, run_train,
+    run_train_observed, stopped_by_observer,
+};
 pub use tank_car::{
     BodyMass, CarBodies, CarPlacement, ContactParams, SuspensionParams, TankCarParams, WheelLoad, add_coupler,
     add_tank_car, wheel_loads,

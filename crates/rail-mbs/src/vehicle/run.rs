@@ -280,11 +280,51 @@ pub(crate) fn record_sample(
     Ok(())
 }
 
+/// Progress of a run, passed to an [`Observer`] after every accepted step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Progress {
+    /// Simulated time reached, s.
+    pub t: f64,
+    /// End time of the run, s.
+    pub t_end: f64,
+    /// Accepted steps so far.
+    pub steps: usize,
+    /// Newton iterations so far.
+    pub newton_iterations: usize,
+    /// Rejected step attempts so far.
+    pub rejected_steps: usize,
+}
+
+impl Progress {
+    /// The progress of `hht` towards `t_end`.
+    pub fn of<S: crate::integrator::MechanicalSystem>(hht: &Hht<S>, t_end: f64) -> Self {
+        let s = hht.stats();
+        Self {
+            t: hht.t(),
+            t_end,
+            steps: s.steps,
+            newton_iterations: s.newton_iterations,
+            rejected_steps: s.rejected_steps,
+        }
+    }
+}
+
+/// Observer of a run (e.g. a progress bar): called after every accepted step; returning
+/// `false` stops the run, which then fails with [`stopped_by_observer`] at that time.
+pub type Observer<'a> = &'a mut dyn FnMut(&Progress) -> bool;
+
+/// The error of a run stopped by its [`Observer`].
+pub fn stopped_by_observer(t: f64) -> IntegratorError {
+    IntegratorError::InvalidSystem { what: format!("run stopped by its progress observer at t = {t} s") }
+}
+
 /// Steps `hht` to every recording time of `sc` (0, `record_every`, … `t_end`), calling
-/// `record(hht, k)` at sample `k`; stops at the first error.
+/// `record(hht, k)` at sample `k` and `observe` after every step; stops at the first
+/// error or when `observe` returns `false`.
 pub(crate) fn step_and_record<S: crate::integrator::MechanicalSystem>(
     hht: &mut Hht<S>,
     sc: &TrainScenario,
+    observe: Observer<'_>,
     mut record: impl FnMut(&mut Hht<S>, usize) -> Result<(), IntegratorError>,
 ) -> Result<(), IntegratorError> {
     let n_rec = (sc.t_end / sc.record_every).round() as usize;
@@ -292,6 +332,9 @@ pub(crate) fn step_and_record<S: crate::integrator::MechanicalSystem>(
         let target = (k as f64 * sc.record_every).min(sc.t_end);
         while hht.t() < target - 1e-12 {
             hht.step(sc.step.min(target - hht.t()))?;
+            if !observe(&Progress::of(hht, sc.t_end)) {
+                return Err(stopped_by_observer(hht.t()));
+            }
         }
         record(hht, k)?;
     }
@@ -300,6 +343,14 @@ pub(crate) fn step_and_record<S: crate::integrator::MechanicalSystem>(
 
 /// Runs a scenario; on failure returns what was recorded so far with the error.
 pub fn run_train(sc: &TrainScenario) -> Result<Result<TrainRecord, Box<TrainFailure>>, AncfError> {
+    run_train_observed(sc, &mut |_| true)
+}
+
+/// [`run_train`] with an [`Observer`] of its progress.
+pub fn run_train_observed(
+    sc: &TrainScenario,
+    observe: Observer<'_>,
+) -> Result<Result<TrainRecord, Box<TrainFailure>>, AncfError> {
     let (mb, cars, couplers) = build_train(sc)?;
     let mut rec = TrainRecord { static_wheel_load: cars[0].static_wheel_load, dof: mb.dof(), ..Default::default() };
     let (q0, v0) = mb.initial_coordinates();
@@ -320,7 +371,7 @@ pub fn run_train(sc: &TrainScenario) -> Result<Result<TrainRecord, Box<TrainFail
         Err(error) => return Ok(Err(Box::new(TrainFailure { error, record: finish(None, rec) }))),
     };
     let mut hints: Vec<f64> = cars.iter().flat_map(|c| [c.station; 4]).collect();
-    let result = step_and_record(&mut hht, sc, |hht, _| {
+    let result = step_and_record(&mut hht, sc, observe, |hht, _| {
         let (t, q, v) = (hht.t(), hht.q().to_vec(), hht.v().to_vec());
         record_sample(hht.system_mut(), (t, &q, &v), &sc.track, &cars, &couplers, &mut hints, &mut rec)
     });

@@ -152,14 +152,21 @@ fn finish(
 
 /// Runs a braking case.
 pub fn run_braking(case: &BrakingCase) -> Result<FluidTrainRecord> {
+    run_braking_with(case, 4e-3, TrainScenario::default_hht().rel_tol)
+}
+
+/// [`run_braking`] with a given largest time step `step` (s) and Newton relative
+/// tolerance `rel_tol` (the work–precision sweeps vary them).
+pub fn run_braking_with(case: &BrakingCase, step: f64, rel_tol: f64) -> Result<FluidTrainRecord> {
     let p = TankCarParams::standard()?;
     let cg = cargo(case.oil, case.counts, case.bulkheads, &p)?;
     let v0 = 40.0 / 3.6;
     let mut sc = TrainScenario::single(p.clone(), tangent()?, 300.0, v0, case.t_end);
     sc.cars = case.cars;
-    sc.step = 4e-3;
+    sc.step = step;
     sc.record_every = 0.02;
     sc.hht.refresh_rate = 0.5;
+    sc.hht.rel_tol = rel_tol;
     // Torque sized with the fluid mass of the mesh (total mass of one car).
     let fluid_mass = {
         let body = ancf_core::FluidBody::new(

@@ -1,0 +1,229 @@
+"""Parameter sweeps of a scene on Dask: every point of a grid (oil type x fill x braking x
+bulkheads x speed, or any scene field) is one run; the results are gathered into one
+``xarray.Dataset`` with the sweep parameters as dimensions.
+
+    >>> from railslosh import sweep
+    >>> grid = sweep.parse_grid(["oil=light,heavy", "fill=0.5,0.7"])
+    >>> ds = sweep.run_sweep("examples/scenes/crude_ecp_braking_light.toml", grid)   # LocalCluster
+    >>> ds["coupler_force"].sel(oil="heavy", fill=0.7)
+
+Grid names: ``oil`` (``fluid.oil``), ``fill`` (``fluid.fill``), ``braking`` (``ecp`` / ``all`` or
+``conventional`` / ``front``: ``brake.scope``), ``bulkheads`` (number of equally spaced 20 mm
+bulkheads: ``tank.bulkheads``), ``speed`` (km/h: ``train.speed_kmh``, or the maneuver speed of a
+slosh scene), or any dotted scene field ``section.key``. Runs are distributed with
+``dask.distributed``: a ``LocalCluster`` by default (threads: the Rust solver releases the GIL),
+or the scheduler at ``address`` (its workers need railslosh installed).
+"""
+
+from __future__ import annotations
+
+import itertools
+import os
+import time
+import tomllib
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+__all__ = ["ALIASES", "grid_overrides", "parse_grid", "parse_value", "run_point", "run_sweep"]
+
+ALIASES = {
+    "oil": "fluid.oil",
+    "fill": "fluid.fill",
+    "braking": "brake.scope",
+    "bulkheads": "tank.bulkheads",
+    "speed": "train.speed_kmh",
+}
+"""Short grid names and the scene field each sets."""
+
+_BRAKING = {"ecp": "all", "conventional": "front", "all": "all", "front": "front"}
+
+
+def parse_value(text: str) -> Any:
+    """A TOML value (``0.5``, ``true``, ``[1, 2]``, ``"x"``), or the bare text as a string."""
+    try:
+        return tomllib.loads(f"v = {text}")["v"]
+    except tomllib.TOMLDecodeError:
+        return text.strip()
+
+
+def parse_grid(specs: Sequence[str]) -> dict[str, list[Any]]:
+    """``["oil=light,heavy", "fill=0.5,0.7"]`` -> ``{"oil": ["light", "heavy"], "fill": [0.5, 0.7]}``."""
+    grid: dict[str, list[Any]] = {}
+    for spec in specs:
+        name, sep, values = spec.partition("=")
+        name = name.strip()
+        if not sep or not name or not values.strip():
+            raise ValueError(f"invalid parameter `--grid` = {spec!r}: allowed NAME=V1,V2,...")
+        if name in grid:
+            raise ValueError(f"invalid parameter `--grid {name}`: given twice")
+        vals = [parse_value(v) for v in values.split(",") if v.strip()]
+        if len(set(map(repr, vals))) != len(vals):
+            raise ValueError(f"invalid parameter `--grid {name}` = {values!r}: allowed distinct values")
+        grid[name] = vals
+    return grid
+
+
+def _set(over: dict[str, Any], dotted: str, value: Any) -> None:
+    keys = dotted.split(".")
+    if len(keys) != 2 or not all(keys):
+        raise ValueError(f"invalid parameter `{dotted}`: allowed a grid name ({', '.join(ALIASES)}) or section.key")
+    over.setdefault(keys[0], {})[keys[1]] = value
+
+
+def _bulkheads(n: Any, tank_length: float = 12.0) -> list[list[float]]:
+    if isinstance(n, bool) or not isinstance(n, int) or not 0 <= n <= 5:
+        raise ValueError(f"invalid parameter `bulkheads` = {n!r}: allowed an integer 0 to 5 (equally spaced)")
+    shell = tank_length - 1.0
+    return [[round(-shell / 2 + shell * (k + 1) / (n + 1), 6), 0.02] for k in range(n)]
+
+
+def grid_overrides(base: Mapping[str, Any], point: Mapping[str, Any]) -> dict[str, Any]:
+    """Scene overrides (for :func:`railslosh.scene.load_scene`) of one grid point."""
+    over: dict[str, Any] = {}
+    slosh = "maneuver" in base
+    for name, value in point.items():
+        if name == "braking":
+            if value not in _BRAKING:
+                raise ValueError(f"invalid parameter `braking` = {value!r}: allowed one of {', '.join(_BRAKING)}")
+            _set(over, "brake.scope", _BRAKING[value])
+        elif name == "bulkheads":
+            # overall tank length: the car's (shell + two 0.5 m heads) or a slosh tank's shell + 1 m
+            length = float(base.get("tank", {}).get("length", 11.0)) + 1.0 if slosh else 12.0
+            if not slosh and isinstance(base.get("car"), Mapping):
+                length = float(base["car"].get("tank_length", 12.0))
+            _set(over, "tank.bulkheads", _bulkheads(value, length))
+        elif name == "speed" and slosh:
+            over.setdefault("maneuver", {}).update({"speed": None, "speed_mph": None, "speed_kmh": value})
+        elif name == "speed":
+            over.setdefault("train", {}).update({"speed": None, "speed_kmh": value})
+        else:
+            _set(over, ALIASES.get(name, name), value)
+    return over
+
+
+def _time_grid(sc: Any) -> np.ndarray:
+    dt = sc.record_every if sc.kind != "slosh" else sc.step
+    n = int(round(sc.t_end / dt))
+    return np.linspace(0.0, n * dt, n + 1)
+
+
+def run_point(base: Mapping[str, Any], overrides: Mapping[str, Any]) -> Any:
+    """Runs one grid point; returns its Dataset on the scene's uniform time grid (slosh runs, which
+    record every adaptive step, are interpolated onto multiples of ``solver.step``), with the run's
+    ``wall_time``, ``steps`` and ``error`` (empty when it finished) as scalar variables."""
+    from railslosh import results, scene
+    from railslosh.slosh import SimulationError
+
+    sc = scene.load_scene(base, overrides)
+    t0 = time.perf_counter()
+    error = ""
+    try:
+        res = scene.run_scene(sc)
+    except SimulationError as exc:
+        res, error = dict(exc.results), str(exc)
+        res["scene"] = sc
+    ds = results.to_dataset(res, sc)
+    grid = _time_grid(sc)
+    t = ds["time"].values
+    if len(t) <= len(grid) and np.allclose(t, grid[: len(t)], rtol=0.0, atol=1e-9):
+        ds = ds.assign_coords(time=("time", grid[: len(t)], ds["time"].attrs))  # exactly the common grid
+    elif len(t) >= 2:
+        ds = ds.interp(time=grid[grid <= t[-1] + 1e-9])
+    stats = res.get("stats") or {}
+    ds["wall_time"] = ((), time.perf_counter() - t0, {"units": "s", "long_name": "wall time of the run"})
+    ds["steps"] = ((), int(stats.get("steps", 0)), {"units": "1", "long_name": "accepted steps"})
+    ds["error"] = ((), error, {"long_name": "why the run stopped early (empty: it finished)"})
+    ds.attrs = {k: v for k, v in ds.attrs.items() if not k.startswith("stats_") and k != "scene_json"}
+    return ds
+
+
+def _client(scheduler: str | None, workers: int, processes: bool) -> Any:
+    from dask.distributed import Client, LocalCluster
+
+    if scheduler:
+        return Client(scheduler)
+    cluster = LocalCluster(
+        n_workers=1 if not processes else workers,
+        threads_per_worker=workers if not processes else 1,
+        processes=processes,
+        dashboard_address=None,
+    )
+    return Client(cluster)
+
+
+def run_sweep(
+    scene_source: str | os.PathLike[str] | Mapping[str, Any],
+    grid: Mapping[str, Sequence[Any]],
+    *,
+    overrides: Mapping[str, Any] | None = None,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    processes: bool = False,
+    client: Any = None,
+    on_done: Any = None,
+) -> Any:
+    """Runs every point of ``grid`` (name -> values) on Dask and returns one Dataset with a
+    dimension per grid name (coordinates = the grid values as given). Every point is validated
+    before anything runs (a bad value raises ``ValueError`` naming the field). ``overrides`` apply to
+    every point; ``client`` (a ``dask.distributed.Client``) or ``scheduler`` (an address) choose the
+    cluster, else a ``LocalCluster`` with ``workers`` (default: CPU count) threads (``processes=True``:
+    worker processes). ``on_done(done, total)`` is called as runs finish. Points whose run stopped
+    early hold the results up to the failure (NaN after it) and their message in ``error``."""
+    import xarray as xr
+
+    from railslosh import scene
+
+    if not grid:
+        raise ValueError("invalid parameter `grid` = {}: allowed at least one NAME=V1,V2,...")
+    if isinstance(scene_source, Mapping):
+        base: dict[str, Any] = dict(scene_source)
+    else:
+        p = Path(scene_source)
+        try:
+            base = tomllib.loads(p.read_text(encoding="utf-8"))
+        except tomllib.TOMLDecodeError as exc:
+            raise ValueError(f"invalid scene TOML in {p}: {exc}") from exc
+    if overrides:
+        base = scene._merge(base, overrides)
+    names = list(grid)
+    points = [dict(zip(names, combo, strict=True)) for combo in itertools.product(*(grid[n] for n in names))]
+    overs = []
+    for pt in points:
+        over = grid_overrides(base, pt)
+        try:
+            scene.load_scene(base, over)
+        except ValueError as exc:
+            raise ValueError(f"sweep point {pt}: {exc}") from exc
+        overs.append(over)
+
+    own = client is None
+    if own:
+        client = _client(scheduler, workers or os.cpu_count() or 1, processes)
+    try:
+        from dask.distributed import as_completed
+
+        futures = [client.submit(run_point, base, o, pure=False) for o in overs]
+        index = {f.key: i for i, f in enumerate(futures)}
+        out: list[Any] = [None] * len(futures)
+        for k, fut in enumerate(as_completed(futures), 1):
+            out[index[fut.key]] = fut.result()
+            if on_done is not None:
+                on_done(k, len(futures))
+    finally:
+        if own:
+            cluster = getattr(client, "cluster", None)
+            client.close()
+            if cluster is not None:
+                cluster.close()
+    # one hypercube: every point on the union of the time grids
+    expanded = [ds.expand_dims({n: [pt[n]] for n in names}) for ds, pt in zip(out, points, strict=True)]
+    combined = xr.combine_by_coords(expanded, data_vars="all", combine_attrs="drop_conflicts", join="outer")
+    combined.attrs["sweep_dims"] = ",".join(names)
+    for n in names:
+        combined[n].attrs["long_name"] = f"sweep parameter {ALIASES.get(n, n)}"
+        if n == "speed":
+            combined[n].attrs["units"] = "km/h"
+    return combined
