@@ -294,6 +294,7 @@ def run_train(
     coupler_damping: float | None = None,
     car: dict[str, float] | None = None,
     progress: _Progress | None = None,
+    stream: str | None = None,
 ) -> dict[str, Any]: ...
 def design_brake_torque(
     mass: float, v0: float = ..., v1: float = ..., duration: float = 10.0
@@ -321,6 +322,7 @@ def run_fluid_train(
     wheel_profile: str = "s1002",
     car: dict[str, float] | None = None,
     progress: _Progress | None = None,
+    stream: str | None = None,
 ) -> dict[str, Any]: ...
 
 # --- co-simulation: the slosh participant (rail_mbs::cosim, issue 6) ---

@@ -164,7 +164,6 @@ def run(
     return res
 
 
-_STREAM_MAGIC = b"RSLJRNL1"
 _VECTORS = ("force_tank", "moment_tank", "force_global", "moment_global", "com_tank")
 _SCALARS = ("volume", "kinetic_energy", "potential_energy", "newton_iterations", "max_penetration")
 
@@ -175,19 +174,9 @@ def read_stream(path: str | os.PathLike[str]) -> dict:
     The format is the journal of ``rail_mbs::integrator::Journal`` (docs/robustness.md)."""
     import numpy as np
 
-    with open(path, "rb") as f:
-        data = f.read()
-    if data[:8] != _STREAM_MAGIC or len(data) < 12:
-        raise ValueError(f"invalid parameter `path` = {os.fspath(path)!r}: allowed a slosh stream file")
-    ncol = int.from_bytes(data[8:12], "little")
-    pos, names = 12, []
-    for _ in range(ncol):
-        n = int.from_bytes(data[pos : pos + 4], "little")
-        names.append(data[pos + 4 : pos + 4 + n].decode())
-        pos += 4 + n
-    rows = (len(data) - pos) // (8 * ncol)
-    table = np.frombuffer(data, dtype="<f8", count=rows * ncol, offset=pos).reshape(rows, ncol)
-    col = {name: table[:, i].copy() for i, name in enumerate(names)}
+    from railslosh.journal import read_journal
+
+    col = read_journal(path, "slosh stream")
     out: dict = {"t": col["t"]}
     for v in _VECTORS:
         out[v] = np.stack([col[f"{v}_{a}"] for a in "xyz"], axis=1)

@@ -16,6 +16,7 @@ left; coupler forces are positive in tension.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -24,7 +25,7 @@ import numpy as np
 from railslosh import _core
 from railslosh.slosh import SimulationError
 
-__all__ = ["design_brake_torque", "run", "run_fluid", "tank_car_parameters"]
+__all__ = ["design_brake_torque", "read_stream", "run", "run_fluid", "tank_car_parameters"]
 
 
 def tank_car_parameters(car: dict[str, float] | None = None, wheel_profile: str = "s1002") -> dict[str, float]:
@@ -86,6 +87,7 @@ def run(
     coupler_damping: float | None = None,
     car: dict[str, float] | None = None,
     progress: Callable[[float, float, int, int, int], object] | None = None,
+    stream: str | os.PathLike[str] | None = None,
 ) -> dict[str, Any]:
     """Run ``cars`` coupled tank cars on ``track`` and return arrays of wheel loads ``Q``
     (``wheel_vertical``), lateral wheel forces ``Y``, ``l_over_v``, the wheel ``unloading`` ratio
@@ -96,7 +98,8 @@ def run(
     braked cars (``brake_scope`` ``"all"`` = ECP, ``"front"`` = front car only).
     ``progress(t, t_end, steps, newton_iterations, rejected_steps)`` is called after the first step,
     then about every 0.5 s of wall time and at the end; if it raises, the run stops and the
-    exception propagates.
+    exception propagates. ``stream`` (a file path) writes every recorded sample to that file as it
+    is computed (flushed per sample), so an interrupted run keeps it; read it with :func:`read_stream`.
 
     Raises ``ValueError`` naming a bad field, and :class:`railslosh.slosh.SimulationError` (with
     ``.results`` up to the failure) when the run stops early.
@@ -123,6 +126,7 @@ def run(
             coupler_damping=coupler_damping,
             car=car,
             progress=progress,
+            stream=None if stream is None else os.fspath(stream),
         )
     )
     return _raise_on_error(res, "vehicle run")
@@ -159,6 +163,7 @@ def run_fluid(
     wheel_profile: str = "s1002",
     car: dict[str, float] | None = None,
     progress: Callable[[float, float, int, int, int], object] | None = None,
+    stream: str | os.PathLike[str] | None = None,
 ) -> dict[str, Any]:
     """Run tank cars whose tanks carry an ANCF fluid, solved monolithically with the cars.
 
@@ -168,7 +173,7 @@ def run_fluid(
     in the tank frame (m). Returns the arrays of :func:`run` plus ``oil_com_tank`` and ``oil_com_global``
     (samples, cars, 3), ``fluid_force_tank`` (the fluid's load on each tank, tank frame), ``volume_error``
     and ``snapshots`` (``[(t, [nodes x 4 x 3 per car])]``, position then gradients per node).
-    ``progress`` is called as in :func:`run`.
+    ``progress`` and ``stream`` work as in :func:`run`.
     """
     drive_speed, times, torques = _drive_and_brake(drive, speed, brake)
     res = dict(
@@ -194,6 +199,40 @@ def run_fluid(
             wheel_profile=wheel_profile,
             car=car,
             progress=progress,
+            stream=None if stream is None else os.fspath(stream),
         )
     )
     return _raise_on_error(res, "fluid vehicle run")
+
+
+def read_stream(path: str | os.PathLike[str]) -> dict[str, Any]:
+    """The samples of a :func:`run` or :func:`run_fluid` ``stream`` file (also of an interrupted
+    run: every complete sample), as arrays shaped like the run's results: ``t``,
+    ``wheel_vertical`` and ``wheel_lateral`` (samples, wheelsets, [left, right]),
+    ``wheelset_lateral``, ``coupler_force``, ``tank_station``, ``tank_speed`` and, for fluid runs,
+    ``oil_com_tank``, ``fluid_force_tank`` (samples, cars, 3) and ``volume_error``."""
+    import re
+
+    from railslosh.journal import read_journal
+
+    col = read_journal(path, "vehicle stream")
+    out: dict[str, Any] = {"t": col.pop("t")}
+    groups: dict[str, dict[tuple[int, int], np.ndarray]] = {}
+    pattern = re.compile(r"^(\w+)\[(\d+)\](?:\.(left|right|x|y|z))?$")
+    comp = {None: 0, "left": 0, "right": 1, "x": 0, "y": 1, "z": 2}
+    width: dict[str, int] = {}
+    for name, values in col.items():
+        m = pattern.match(name)
+        if m is None:
+            raise ValueError(f"invalid parameter `path` = {os.fspath(path)!r}: unknown column {name!r}")
+        key, i, c = m.group(1), int(m.group(2)), m.group(3)
+        groups.setdefault(key, {})[(i, comp[c])] = values
+        width[key] = 0 if c is None else max(width.get(key, 0), comp[c] + 1)
+    for key, cells in groups.items():
+        n = max(i for i, _ in cells) + 1
+        w = width[key]
+        arr = np.zeros((len(out["t"]), n, max(w, 1)))
+        for (i, c), v in cells.items():
+            arr[:, i, c] = v
+        out[key] = arr[:, :, 0] if w == 0 else arr
+    return out

@@ -13,7 +13,7 @@ use rail_mbs::track::{Track, TrackPoint};
 use rail_mbs::vehicle::studies::{Oil, brake_torque};
 use rail_mbs::vehicle::{
     BrakeScope, FluidCargo, FluidTrainRecord, TankCarParams, TrainRecord, TrainScenario,
-    run_fluid_train_observed as rust_run_fluid_train, run_train_observed as rust_run_train,
+    run_fluid_train_streamed as rust_run_fluid_train, run_train_streamed as rust_run_train,
 };
 
 use crate::{PyProgress, compute};
@@ -180,7 +180,7 @@ fn brake_of(times: Option<Vec<f64>>, torques: Option<Vec<f64>>, scope: &str) -> 
     track, *, cars=1, station=50.0, speed=0.0, t_end=1.0, step=1e-3, record_every=0.01,
     drive_speed=None, brake_times=None, brake_torques=None, brake_scope="all",
     lading_mass=0.0, lading_height=0.0, wheel_profile="s1002", wheelset_lateral_offset=0.0,
-    coupler_stiffness=None, coupler_damping=None, car=None, progress=None
+    coupler_stiffness=None, coupler_damping=None, car=None, progress=None, stream=None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn run_train<'py>(
@@ -204,6 +204,7 @@ pub fn run_train<'py>(
     coupler_damping: Option<f64>,
     car: Option<&Bound<'py, PyDict>>,
     progress: Option<Py<PyAny>>,
+    stream: Option<std::path::PathBuf>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let mut params = car_params(car, wheel_profile)?;
     if lading_mass != 0.0 {
@@ -221,7 +222,12 @@ pub fn run_train<'py>(
     sc.coupler = (coupler_stiffness, coupler_damping);
     let mut observer = PyProgress::new(progress);
     let obs = &mut observer;
-    let out = compute(py, move || rust_run_train(&sc, &mut |p| obs.observe(p)))?;
+    let columns = rail_mbs::vehicle::TrainRecord::columns(4 * sc.cars, sc.cars.saturating_sub(1), sc.cars);
+    let out = compute(py, move || {
+        let mut journal = open_stream(stream.as_deref(), &columns)?;
+        let mut sink = |row: &[f64]| journal.as_mut().map_or(Ok(()), |j| j.append(row));
+        rust_run_train(&sc, &mut |p| obs.observe(p), Some(&mut sink))
+    })?;
     observer.finish()?;
     match out {
         Ok(r) => record_dict(py, &r),
@@ -231,6 +237,19 @@ pub fn run_train<'py>(
             Ok(d)
         }
     }
+}
+
+/// The results stream of a run (`stream=` path): every recorded sample is appended and
+/// flushed as it is computed, so an interrupted run keeps it (issue 8).
+fn open_stream(
+    path: Option<&std::path::Path>,
+    columns: &[String],
+) -> Result<Option<rail_mbs::integrator::Journal>, ancf_core::error::AncfError> {
+    let Some(path) = path else { return Ok(None) };
+    let names: Vec<&str> = columns.iter().map(String::as_str).collect();
+    rail_mbs::integrator::Journal::create(path, &names, 1)
+        .map(Some)
+        .map_err(|e| invalid("stream", path.display(), &format!("a writable file ({e})")))
 }
 
 fn oil_of(name: &str) -> PyResult<Oil> {
@@ -290,7 +309,7 @@ pub fn design_brake_torque(mass: f64, v0: f64, v1: f64, duration: f64) -> PyResu
     track, *, cars=1, station=300.0, speed=0.0, t_end=1.0, step=4e-3, record_every=0.02, snapshot_every=0.0,
     drive_speed=None, brake_times=None, brake_torques=None, brake_scope="all", brake_factors=None,
     oil="light", fluid=None, counts=(6, 4, 2), fill=0.5, bulkheads=None, wheel_profile="s1002", car=None,
-    progress=None
+    progress=None, stream=None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn run_fluid_train<'py>(
@@ -316,6 +335,7 @@ pub fn run_fluid_train<'py>(
     wheel_profile: &str,
     car: Option<&Bound<'py, PyDict>>,
     progress: Option<Py<PyAny>>,
+    stream: Option<std::path::PathBuf>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let params = car_params(car, wheel_profile)?;
     let brake = brake_of(brake_times, brake_torques, brake_scope)?;
@@ -340,7 +360,12 @@ pub fn run_fluid_train<'py>(
     sc.hht.refresh_rate = 0.5;
     let mut observer = PyProgress::new(progress);
     let obs = &mut observer;
-    let out = compute(py, move || rust_run_fluid_train(&sc, &cargo, &mut |p| obs.observe(p)))?;
+    let columns = rail_mbs::vehicle::FluidTrainRecord::columns(4 * sc.cars, sc.cars.saturating_sub(1), sc.cars);
+    let out = compute(py, move || {
+        let mut journal = open_stream(stream.as_deref(), &columns)?;
+        let mut sink = |row: &[f64]| journal.as_mut().map_or(Ok(()), |j| j.append(row));
+        rust_run_fluid_train(&sc, &cargo, &mut |p| obs.observe(p), Some(&mut sink))
+    })?;
     observer.finish()?;
     match out {
         Ok(r) => fluid_record_dict(py, &r),

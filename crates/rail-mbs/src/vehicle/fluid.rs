@@ -441,7 +441,7 @@ use ancf_core::mesh::{CylinderTankSpec, cylinder_tank, cylinder_tank_compartment
 use ancf_core::tank::{Bulkhead, TankGeometry, TankShape};
 use std::time::Instant;
 
-use super::run::{Observer, TrainRecord, TrainScenario, build_train, record_sample, step_and_record};
+use super::run::{Observer, SampleSink, TrainRecord, TrainScenario, build_train, record_sample, step_and_record};
 use super::tank_car::CarBodies;
 use crate::integrator::{Hht, IntegratorError};
 
@@ -509,6 +509,32 @@ pub struct FluidTrainRecord {
     /// Element-node table of each car's fluid mesh (node order A..H, docs/frames.md), for
     /// writing the snapshots as hexahedra.
     pub connectivity: Vec<[usize; 8]>,
+}
+
+impl FluidTrainRecord {
+    /// Column names of [`Self::row`]: the [`TrainRecord::columns`] followed, per car, by the
+    /// oil centre of mass (tank frame), the fluid force on the tank (tank frame) and the
+    /// relative volume change.
+    pub fn columns(wheelsets: usize, couplers: usize, cars: usize) -> Vec<String> {
+        let mut c = TrainRecord::columns(wheelsets, couplers, cars);
+        for k in 0..cars {
+            c.extend(["x", "y", "z"].map(|a| format!("oil_com_tank[{k}].{a}")));
+            c.extend(["x", "y", "z"].map(|a| format!("fluid_force_tank[{k}].{a}")));
+            c.push(format!("volume_error[{k}]"));
+        }
+        c
+    }
+
+    /// Sample `i` as one flat row in the order of [`Self::columns`].
+    pub fn row(&self, i: usize) -> Vec<f64> {
+        let mut r = self.train.row(i);
+        for k in 0..self.oil_com_tank[i].len() {
+            r.extend(self.oil_com_tank[i][k]);
+            r.extend(self.fluid_force_tank[i][k]);
+            r.push(self.volume_error[i][k]);
+        }
+        r
+    }
 }
 
 /// A fluid run that stopped early: why, and what was recorded.
@@ -600,6 +626,17 @@ pub fn run_fluid_train_observed(
     cargo: &FluidCargo,
     observe: Observer<'_>,
 ) -> Result<Result<FluidTrainRecord, Box<FluidTrainFailure>>, AncfError> {
+    run_fluid_train_streamed(sc, cargo, observe, None)
+}
+
+/// [`run_fluid_train_observed`] that also passes every recorded sample to `sink`
+/// (layout [`FluidTrainRecord::columns`]).
+pub fn run_fluid_train_streamed(
+    sc: &TrainScenario,
+    cargo: &FluidCargo,
+    observe: Observer<'_>,
+    mut sink: Option<SampleSink<'_>>,
+) -> Result<Result<FluidTrainRecord, Box<FluidTrainFailure>>, AncfError> {
     let (sys, cars, couplers) = build_fluid_train(sc, cargo)?;
     let mut rec = FluidTrainRecord {
         fluid_mass: sys.fluids[0].body.total_mass(),
@@ -641,7 +678,10 @@ pub fn run_fluid_train_observed(
                 rec.snapshots.push((t, e));
             }
         }
-        Ok(())
+        match sink.as_mut() {
+            Some(sink) => sink(&rec.row(rec.train.t.len() - 1)),
+            None => Ok(()),
+        }
     });
     if let Err(error) = result {
         return Ok(Err(Box::new(FluidTrainFailure { error, record: finish(Some(&hht), rec) })));

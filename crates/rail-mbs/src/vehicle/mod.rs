@@ -41,11 +41,11 @@ pub mod validate;
 
 pub use fluid::{
     FluidCargo, FluidTrainFailure, FluidTrainRecord, FluidVehicle, TankFluid, build_fluid_train, run_fluid_train,
-    run_fluid_train_observed,
+    run_fluid_train_observed, run_fluid_train_streamed,
 };
 pub use run::{
-    BrakeScope, Observer, Progress, TrainFailure, TrainRecord, TrainScenario, build_train, run_train,
-    run_train_observed, stopped_by_observer,
+    BrakeScope, Observer, Progress, SampleSink, TrainFailure, TrainRecord, TrainScenario, build_train, run_train,
+    run_train_observed, run_train_streamed, stopped_by_observer,
 };
 pub use tank_car::{
     BodyMass, CarBodies, CarPlacement, ContactParams, SuspensionParams, TankCarParams, WheelLoad, add_coupler,

@@ -153,6 +153,39 @@ pub struct TrainRecord {
 }
 
 impl TrainRecord {
+    /// Column names of [`Self::row`] for a train with `wheelsets` wheelsets, `couplers`
+    /// couplers and `cars` cars (the layout of a results stream, `run_train_streamed`).
+    pub fn columns(wheelsets: usize, couplers: usize, cars: usize) -> Vec<String> {
+        let mut c = vec!["t".to_string()];
+        for w in 0..wheelsets {
+            for side in ["left", "right"] {
+                c.push(format!("wheel_vertical[{w}].{side}"));
+            }
+        }
+        for w in 0..wheelsets {
+            for side in ["left", "right"] {
+                c.push(format!("wheel_lateral[{w}].{side}"));
+            }
+        }
+        c.extend((0..wheelsets).map(|w| format!("wheelset_lateral[{w}]")));
+        c.extend((0..couplers).map(|k| format!("coupler_force[{k}]")));
+        c.extend((0..cars).map(|k| format!("tank_station[{k}]")));
+        c.extend((0..cars).map(|k| format!("tank_speed[{k}]")));
+        c
+    }
+
+    /// Sample `i` as one flat row in the order of [`Self::columns`].
+    pub fn row(&self, i: usize) -> Vec<f64> {
+        let mut r = vec![self.t[i]];
+        r.extend(self.wheel_vertical[i].iter().flatten());
+        r.extend(self.wheel_lateral[i].iter().flatten());
+        r.extend(&self.wheelset_lateral[i]);
+        r.extend(&self.coupler_force[i]);
+        r.extend(&self.tank_station[i]);
+        r.extend(&self.tank_speed[i]);
+        r
+    }
+
     /// Mean over samples with `t ≥ t0` of the vertical load of `(wheelset, side)`.
     pub fn mean_vertical(&self, t0: f64, wheelset: usize, side: usize) -> f64 {
         let v: Vec<f64> = self
@@ -346,10 +379,24 @@ pub fn run_train(sc: &TrainScenario) -> Result<Result<TrainRecord, Box<TrainFail
     run_train_observed(sc, &mut |_| true)
 }
 
+/// Receives every recorded sample as a flat row (`TrainRecord::row` layout, extended by
+/// `FluidTrainRecord::row` for fluid runs) as soon as it is recorded: a results stream that
+/// an interrupted run cannot lose (e.g. a [`crate::integrator::Journal`]).
+pub type SampleSink<'a> = &'a mut dyn FnMut(&[f64]) -> Result<(), IntegratorError>;
+
 /// [`run_train`] with an [`Observer`] of its progress.
 pub fn run_train_observed(
     sc: &TrainScenario,
     observe: Observer<'_>,
+) -> Result<Result<TrainRecord, Box<TrainFailure>>, AncfError> {
+    run_train_streamed(sc, observe, None)
+}
+
+/// [`run_train_observed`] that also passes every recorded sample to `sink`.
+pub fn run_train_streamed(
+    sc: &TrainScenario,
+    observe: Observer<'_>,
+    mut sink: Option<SampleSink<'_>>,
 ) -> Result<Result<TrainRecord, Box<TrainFailure>>, AncfError> {
     let (mb, cars, couplers) = build_train(sc)?;
     let mut rec = TrainRecord { static_wheel_load: cars[0].static_wheel_load, dof: mb.dof(), ..Default::default() };
@@ -373,7 +420,11 @@ pub fn run_train_observed(
     let mut hints: Vec<f64> = cars.iter().flat_map(|c| [c.station; 4]).collect();
     let result = step_and_record(&mut hht, sc, observe, |hht, _| {
         let (t, q, v) = (hht.t(), hht.q().to_vec(), hht.v().to_vec());
-        record_sample(hht.system_mut(), (t, &q, &v), &sc.track, &cars, &couplers, &mut hints, &mut rec)
+        record_sample(hht.system_mut(), (t, &q, &v), &sc.track, &cars, &couplers, &mut hints, &mut rec)?;
+        match sink.as_mut() {
+            Some(sink) => sink(&rec.row(rec.t.len() - 1)),
+            None => Ok(()),
+        }
     });
     if let Err(error) = result {
         return Ok(Err(Box::new(TrainFailure { error, record: finish(Some(&hht), rec) })));

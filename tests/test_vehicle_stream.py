@@ -1,0 +1,68 @@
+"""Vehicle runs write their results incrementally (`stream=`), so an interrupted run loses
+nothing already computed (issue 8)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from railslosh import vehicle
+
+TRACK = [[0, 0, 0, 0, 0, 0], [4000, 0, 0, 0, 0, 0]]
+BRAKE = vehicle.design_brake_torque(64e3)
+
+
+def _rigid(**kw):
+    return vehicle.run(TRACK, cars=2, speed=40 / 3.6, t_end=0.3, record_every=0.02, brake=BRAKE, **kw)
+
+
+def test_rigid_stream_equals_the_returned_results_bit_for_bit(tmp_path):
+    path = tmp_path / "run.jrnl"
+    res = _rigid(stream=path)
+    s = vehicle.read_stream(path)
+    assert len(s["t"]) == len(res["t"]) > 10
+    for key in ("t", "wheel_vertical", "wheel_lateral", "wheelset_lateral", "coupler_force", "tank_speed"):
+        assert s[key].shape == res[key].shape, key
+        assert np.array_equal(s[key], res[key]), key
+    assert s["wheel_vertical"].shape[1:] == (8, 2) and s["coupler_force"].shape[1] == 1
+
+
+def test_fluid_stream_carries_the_oil_outputs(tmp_path):
+    path = tmp_path / "fluid.jrnl"
+    res = vehicle.run_fluid(TRACK, cars=1, speed=40 / 3.6, t_end=0.1, counts=(2, 2, 2), oil="heavy", stream=path)
+    s = vehicle.read_stream(path)
+    for key in ("oil_com_tank", "fluid_force_tank", "volume_error", "wheel_vertical"):
+        assert np.array_equal(s[key], res[key]), key
+
+
+def test_interrupted_run_keeps_every_sample_already_computed(tmp_path):
+    full = _rigid()
+    path = tmp_path / "cut.jrnl"
+    calls = []
+
+    def stop(t, t_end, steps, newton, rejected):
+        calls.append(t)
+        if t > 0.15:
+            raise KeyboardInterrupt("user stopped the run")
+
+    with pytest.raises(KeyboardInterrupt):
+        _rigid(stream=path, progress=stop)
+    s = vehicle.read_stream(path)
+    n = len(s["t"])
+    assert 0 < n < len(full["t"])
+    assert s["t"][-1] <= calls[-1] + 1e-12
+    for key in ("t", "wheel_vertical", "coupler_force"):
+        assert np.array_equal(s[key], full[key][:n]), key
+    # a torn last row (the process killed while writing) is dropped, the rest reads back
+    data = path.read_bytes()
+    path.write_bytes(data[:-3])
+    assert len(vehicle.read_stream(path)["t"]) == n - 1
+
+
+def test_stream_errors_name_the_field(tmp_path):
+    with pytest.raises(ValueError, match="stream"):
+        _rigid(stream=tmp_path / "missing-dir" / "x.jrnl")
+    bad = tmp_path / "bad.jrnl"
+    bad.write_bytes(b"not a journal")
+    with pytest.raises(ValueError, match="path"):
+        vehicle.read_stream(bad)
