@@ -66,3 +66,26 @@ def test_stream_errors_name_the_field(tmp_path):
     bad.write_bytes(b"not a journal")
     with pytest.raises(ValueError, match="path"):
         vehicle.read_stream(bad)
+
+
+def test_slosh_run_resumed_from_its_checkpoint_continues_bitwise(tmp_path):
+    import railslosh as rs
+
+    mesh = rs.mesh.box((0.416, 0.324, 0.132), (2, 3, 2), origin=(-0.208, -0.162, 0.0))
+    tank = rs.slosh.box_tank((-0.208, -0.162, 0.0), (0.208, 0.162, 0.3))
+    motion = rs.slosh.Motion().pulse("y", 0.3 * 9.81, 0.0, 0.3)
+    water = rs.fluids.water(depth=0.132)
+    ck = tmp_path / "run.ckpt"
+    full = rs.slosh.run(mesh, water, tank, motion, t_end=0.6, h=0.004, checkpoint=ck, checkpoint_every=40)
+    assert ck.stat().st_size > 0
+    rest = rs.slosh.run(mesh, water, tank, motion, t_end=0.6, h=0.004, resume_from=ck)
+    k = int(np.flatnonzero(full["t"] == rest["t"][0])[0])
+    assert 0 < k < len(full["t"]) - 1
+    assert len(rest["t"]) == len(full["t"]) - k
+    for key in ("t", "force_tank", "moment_tank", "com_tank", "volume", "kinetic_energy", "max_penetration"):
+        assert np.array_equal(rest[key], full[key][k:]), key
+    assert np.array_equal(rest["newton_iterations"][1:], full["newton_iterations"][k + 1 :])
+    with pytest.raises(ValueError, match="resume_from"):
+        rs.slosh.run(mesh, water, tank, motion, t_end=0.6, h=0.004, resume_from=tmp_path / "none.ckpt")
+    with pytest.raises(ValueError, match="checkpoint_every"):
+        rs.slosh.run(mesh, water, tank, motion, t_end=0.6, h=0.004, checkpoint=ck, checkpoint_every=0)

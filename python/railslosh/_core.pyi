@@ -155,6 +155,9 @@ def run_slosh(
     penetration_limit: float = 0.5,
     contact_stiffness_factor: float = 1.0,
     stream: str | os.PathLike[str] | None = None,
+    checkpoint: str | os.PathLike[str] | None = None,
+    checkpoint_every: int = 100,
+    resume_from: str | os.PathLike[str] | None = None,
 ) -> dict[str, Any]: ...
 def run_validation(name: str, quick: bool = False) -> list[dict[str, Any]]: ...
 def work_precision_cases() -> list[str]: ...

@@ -113,6 +113,9 @@ def run(
     penetration_limit: float = 0.5,
     contact_stiffness_factor: float = 1.0,
     stream: str | os.PathLike[str] | None = None,
+    checkpoint: str | os.PathLike[str] | None = None,
+    checkpoint_every: int = 100,
+    resume_from: str | os.PathLike[str] | None = None,
 ) -> dict:
     """Integrate the fluid in the moving tank up to `t_end` with steps of at most `h`.
 
@@ -134,6 +137,13 @@ def run(
     ``stream`` (a file path) writes every sample to that file as it is computed (flushed per step),
     so a run that is interrupted -- killed, out of time -- loses nothing already computed; read it
     with :func:`read_stream`, which returns the arrays of this function.
+
+    ``checkpoint`` (a file path) keeps the integrator state of the run there, rewritten
+    atomically every ``checkpoint_every`` accepted steps. ``resume_from`` continues a run of the
+    same scene from such a file: the results start at the checkpoint time and are bitwise
+    identical to the uninterrupted run's from there on (the first sample reports 0 Newton
+    iterations). Together with ``stream`` this restarts long runs without losing or changing
+    anything.
     """
     motion = motion or Motion()
     unknown = set(motion.acceleration) - set(AXES)
@@ -158,6 +168,9 @@ def run(
         penetration_limit=penetration_limit,
         contact_stiffness_factor=contact_stiffness_factor,
         stream=None if stream is None else os.fspath(stream),
+        checkpoint=None if checkpoint is None else os.fspath(checkpoint),
+        checkpoint_every=checkpoint_every,
+        resume_from=None if resume_from is None else os.fspath(resume_from),
     )
     if res["error"] is not None:
         raise SimulationError(f"slosh run stopped at t = {res['t'][-1]:.4f} s: {res['error']}", res)

@@ -442,7 +442,7 @@ impl PyFluidBody {
 #[pyo3(signature = (mesh, fluid, tank_shape, tank_dims, bulkheads, acceleration, rotation_axis, angular_acceleration,
                     t_end, h, frame="inertial", gravity=[0.0, 0.0, -9.81], viscous_points=3, penalty_points=3,
                     progress=None, volume_tolerance=0.01, penetration_limit=0.5, contact_stiffness_factor=1.0,
-                    stream=None))]
+                    stream=None, checkpoint=None, checkpoint_every=100, resume_from=None))]
 #[allow(clippy::too_many_arguments)]
 fn run_slosh<'py>(
     py: Python<'py>,
@@ -465,6 +465,9 @@ fn run_slosh<'py>(
     penetration_limit: f64,
     contact_stiffness_factor: f64,
     stream: Option<std::path::PathBuf>,
+    checkpoint: Option<std::path::PathBuf>,
+    checkpoint_every: usize,
+    resume_from: Option<std::path::PathBuf>,
 ) -> PyResult<Bound<'py, PyDict>> {
     use ancf_core::contact::{WallContact, WallContactLaw};
     use ancf_core::tank::{Bulkhead, TankGeometry, TankShape};
@@ -534,8 +537,33 @@ fn run_slosh<'py>(
         let mut sys = SloshSystem::new(body, contact, motion, gravity, frame)?;
         sys.volume_tolerance = volume_tolerance;
         sys.penetration_limit *= penetration_limit / rail_mbs::slosh::system::PENETRATION_LIMIT_FACTOR;
-        let mut run = SloshRun::new(sys, 0.0, rail_mbs::slosh::validate::slosh_params())
-            .map_err(|e| AncfError::NonFinite { what: e.to_string(), element: 0 })?;
+        let params = rail_mbs::slosh::validate::slosh_params();
+        let mut run = match &resume_from {
+            // Issue 8: continue a run from its last checkpoint, bitwise as if never stopped.
+            Some(path) => {
+                let cp = rail_mbs::integrator::CheckpointFile::read(path).map_err(|e| {
+                    ancf_core::error::invalid("resume_from", path.display(), &format!("a checkpoint file ({e})"))
+                })?;
+                SloshRun::resume(sys, &cp, params).map_err(|e| {
+                    ancf_core::error::invalid(
+                        "resume_from",
+                        path.display(),
+                        &format!("a checkpoint of a run of this same scene ({e})"),
+                    )
+                })?
+            }
+            None => {
+                SloshRun::new(sys, 0.0, params).map_err(|e| AncfError::NonFinite { what: e.to_string(), element: 0 })?
+            }
+        };
+        if let Some(path) = &checkpoint {
+            if checkpoint_every == 0 {
+                return Err(ancf_core::error::invalid("checkpoint_every", 0, ">= 1 (steps)"));
+            }
+            run.checkpoints = Some(rail_mbs::integrator::CheckpointFile::new(path, checkpoint_every).map_err(|e| {
+                ancf_core::error::invalid("checkpoint", path.display(), &format!("a writable file ({e})"))
+            })?);
+        }
         let result = match &stream {
             // Every sample appended and flushed as it is computed (issue 8: nothing computed is lost).
             Some(path) => {

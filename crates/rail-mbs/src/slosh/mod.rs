@@ -16,7 +16,7 @@ pub use system::{SloshFrame, SloshSystem};
 
 use nalgebra::Vector3;
 
-use crate::integrator::{Hht, HhtParams, IntegratorError, Journal, Stats};
+use crate::integrator::{Checkpoint, CheckpointFile, Hht, HhtParams, IntegratorError, Journal, Stats};
 use crate::vehicle::{Observer, Progress};
 
 /// Time series recorded by a slosh run. Loads are the force and moment the fluid exerts on
@@ -96,6 +96,9 @@ pub struct SloshRun {
     pub hht: Hht<SloshSystem>,
     /// Outputs so far.
     pub record: SloshRecord,
+    /// Periodic checkpoints (`None`: none written): after every accepted step the file
+    /// is rewritten once `every` steps have passed since the last one (issue 8).
+    pub checkpoints: Option<CheckpointFile>,
 }
 
 /// A failed run: the error and everything recorded up to it.
@@ -118,9 +121,28 @@ impl SloshRun {
     pub fn new(system: SloshSystem, t0: f64, params: HhtParams) -> Result<Self, IntegratorError> {
         let (q, v) = system.initial_state(t0);
         let hht = Hht::new(system, t0, q, v, params)?;
-        let mut run = Self { hht, record: SloshRecord::default() };
+        let mut run = Self { hht, record: SloshRecord::default(), checkpoints: None };
         run.record_state(0);
         Ok(run)
+    }
+
+    /// Resume from a checkpoint of an earlier run of the same system (same mesh, fluid,
+    /// tank, motion and parameters): the record starts with the checkpoint's state, and
+    /// the continuation is bitwise identical to the uninterrupted run's (its first
+    /// sample reports 0 Newton iterations).
+    pub fn resume(system: SloshSystem, checkpoint: &Checkpoint, params: HhtParams) -> Result<Self, IntegratorError> {
+        let hht = Hht::restore(system, checkpoint, params)?;
+        let mut run = Self { hht, record: SloshRecord::default(), checkpoints: None };
+        run.record_state(0);
+        Ok(run)
+    }
+
+    /// Write a checkpoint if one is due.
+    fn checkpoint_if_due(&mut self) -> Result<(), IntegratorError> {
+        match self.checkpoints.as_mut() {
+            Some(c) => c.maybe_write(&self.hht).map(|_| ()),
+            None => Ok(()),
+        }
     }
 
     /// Integrate to `t_end` with steps of (at most) `h`, recording every step.
@@ -136,6 +158,9 @@ impl SloshRun {
             match self.hht.step(h_step) {
                 Ok(info) => self.record_state(info.iterations),
                 Err(error) => return Err(Box::new(SloshFailure { error, record: self.record.clone() })),
+            }
+            if let Err(error) = self.checkpoint_if_due() {
+                return Err(Box::new(SloshFailure { error, record: self.record.clone() }));
             }
             if !observe(&Progress::of(&self.hht, t_end)) {
                 let error = crate::vehicle::stopped_by_observer(self.hht.t());
@@ -168,6 +193,7 @@ impl SloshRun {
                 Err(error) => return Err(fail(self, error)),
             }
             journal.append(&self.record.row(self.record.t.len() - 1)).map_err(|e| fail(self, e))?;
+            self.checkpoint_if_due().map_err(|e| fail(self, e))?;
             if !observe(&Progress::of(&self.hht, t_end)) {
                 return Err(fail(self, crate::vehicle::stopped_by_observer(self.hht.t())));
             }
