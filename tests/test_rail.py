@@ -413,3 +413,21 @@ def test_contact_never_panics(s1002_uic60, shift, yaw, load, speed, side):
         return
     assert res["vertical_force"] == pytest.approx(load, rel=1e-6)
     assert np.all(np.isfinite(res["normal_force"]))
+
+
+def test_a_jump_in_the_contact_force_is_an_error_not_a_wrong_load(s1002_uic60):
+    """Found by hypothesis: at 2.7 degrees of yaw the contact search finds the flange contact only
+    from 0.57 mm penetration on, so the vertical force jumps from 0 to 331 kN. A load between the
+    two cannot be met: the solve says so, naming the jump, instead of returning 331 kN as 1 N."""
+    wheel, head = s1002_uic60
+    kw = dict(side="right", rail_cant=1 / 40, lateral_shift=-0.0078125, yaw=0.046875, speed=0.0)
+    try:
+        res = rail.contact(wheel, head, load=1.0, **kw)
+    except rs.RailsloshError as exc:
+        assert "no wheel height meets the target" in str(exc)
+        assert "jumps from" in str(exc)
+    else:
+        assert res["vertical_force"] == pytest.approx(1.0, rel=1e-6)
+    # the same pose under a load above the jump is met exactly
+    res = rail.contact(wheel, head, load=400e3, **kw)
+    assert res["vertical_force"] == pytest.approx(400e3, rel=1e-6)

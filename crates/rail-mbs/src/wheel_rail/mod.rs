@@ -111,6 +111,25 @@ pub enum ContactError {
     /// Bad input (non-finite pose, negative radius, …).
     #[error("invalid contact input: {0}")]
     InvalidInput(String),
+    /// No wheel height meets a vertical target because the measured quantity jumps across
+    /// it (the contact search finds a contact only from some depth on, typically at large
+    /// yaw where the contact point leaves the profile's scanned range).
+    #[error(
+        "no wheel height meets the target {target} (the {quantity} jumps from {below:e} to {above:e} at height \
+         {height} m; contact search discontinuous here)"
+    )]
+    TargetNotMet {
+        /// What was solved for (e.g. "vertical force").
+        quantity: &'static str,
+        /// The target value.
+        target: f64,
+        /// The value just above the jump height (less loaded side).
+        below: f64,
+        /// The value just below the jump height.
+        above: f64,
+        /// The height of the jump, m.
+        height: f64,
+    },
     /// Track query failed.
     #[error("track error: {0}")]
     Track(#[from] crate::track::TrackError),

@@ -127,7 +127,8 @@ pub struct LoadedContact {
 /// Places the wheel at the height that meets `target` (see the module docs) and evaluates
 /// the contact there. Fails with [`ContactError::InvalidInput`] on bad input and when no
 /// height within 50 mm below the nominal one meets the target (e.g. the wheel is off its
-/// rail).
+/// rail), and with [`ContactError::TargetNotMet`] when the measure jumps across the target
+/// (the force at the solved height is then not the target: it is never returned as such).
 pub fn solve_vertical(
     contact: &mut WheelRailContact,
     state: &WheelState,
@@ -197,6 +198,21 @@ pub fn solve_vertical(
     let points = loaded(contact, &pose)?;
     let vertical_force = points.iter().map(|p| p.force_on_wheel().z).sum();
     let max_penetration = points.iter().map(|p| p.geometry.penetration).fold(0.0, f64::max);
+    // Bisection ends on a bracket narrower than the float spacing: a continuous measure meets
+    // the goal there. A jump (a contact found only below some height) must not be returned
+    // as if it were the solution.
+    let reached = match target {
+        VerticalTarget::Load(_) => vertical_force,
+        VerticalTarget::Penetration(_) => max_penetration,
+    };
+    if (reached - goal).abs() > 1e-6 * goal {
+        let quantity = match target {
+            VerticalTarget::Load(_) => "vertical force (N)",
+            VerticalTarget::Penetration(_) => "largest penetration (m)",
+        };
+        let (below, above) = (measure(contact, hi)?, measure(contact, lo)?);
+        return Err(ContactError::TargetNotMet { quantity, target: goal, below, above, height });
+    }
     Ok(LoadedContact { height, pose, points, vertical_force, max_penetration })
 }
 
