@@ -69,11 +69,16 @@ fn resample(t: &[f64], x: &[f64], t0: f64, t1: f64, n: usize) -> (Vec<f64>, Vec<
     (0..=n)
         .map(|k| {
             let tq = t0 + (t1 - t0) * k as f64 / n as f64;
-            let i = t.partition_point(|&v| v <= tq).clamp(1, t.len() - 1);
-            let s = ((tq - t[i - 1]) / (t[i] - t[i - 1])).clamp(0.0, 1.0);
-            (tq, x[i - 1] + s * (x[i] - x[i - 1]))
+            (tq, interp(t, x, tq))
         })
         .unzip()
+}
+
+/// `x(tq)` by linear interpolation of the samples `(t, x)` (held at the ends); `t.len() >= 2`.
+fn interp(t: &[f64], x: &[f64], tq: f64) -> f64 {
+    let i = t.partition_point(|&v| v <= tq).clamp(1, t.len() - 1);
+    let s = ((tq - t[i - 1]) / (t[i] - t[i - 1])).clamp(0.0, 1.0);
+    x[i - 1] + s * (x[i] - x[i - 1])
 }
 
 /// Runs a sweep. `quick`: a small grid for CI (seconds); the full grids take minutes
@@ -133,11 +138,6 @@ fn history_error(t: &[f64], x: &[f64], t_ref: &[f64], x_ref: &[f64], t0: f64, t1
     if t.len() < 2 || t_ref.len() < 2 {
         return f64::NAN;
     }
-    let interp = |ts: &[f64], xs: &[f64], tq: f64| -> f64 {
-        let i = ts.partition_point(|&v| v <= tq).clamp(1, ts.len() - 1);
-        let s = ((tq - ts[i - 1]) / (ts[i] - ts[i - 1])).clamp(0.0, 1.0);
-        xs[i - 1] + s * (xs[i] - xs[i - 1])
-    };
     let t1 = t1.min(*t.last().unwrap_or(&t0)).min(*t_ref.last().unwrap_or(&t0));
     let n = 400;
     let (mut dev, mut lo, mut hi) = (0.0f64, f64::INFINITY, f64::NEG_INFINITY);

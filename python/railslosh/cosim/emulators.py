@@ -285,7 +285,31 @@ def _check_t_end(t_end: float, time: float) -> float:
     return t
 
 
-class PendulumSlosh:
+class _OdeState:
+    """Time ``_t`` and ODE state ``_y`` of an emulator, with the save/restore part of the
+    participant protocol (a saved state is a copy: restoring it replays a window exactly)."""
+
+    _t: float
+    _y: np.ndarray
+
+    @property
+    def time(self) -> float:
+        return self._t
+
+    @property
+    def state(self) -> np.ndarray:
+        """The ODE state: (θ, θ') of a pendulum, (q, q') of a vehicle."""
+        return self._y.copy()
+
+    def save_state(self) -> tuple[float, np.ndarray]:
+        return (self._t, self._y.copy())
+
+    def restore_state(self, s: tuple[float, np.ndarray]) -> None:
+        self._t, y = s
+        self._y = np.array(y, dtype=float)
+
+
+class PendulumSlosh(_OdeState):
     """Slosh emulator: rigid mass m0 at ``rigid_point`` plus a planar pendulum (point mass m1,
     length l1) hinged at ``hinge`` on the tank, swinging about ``hinge_axis`` n, with linear
     damping ratio ζ at the nominal frequency ω1.
@@ -379,23 +403,7 @@ class PendulumSlosh:
         }
         return self.load(y, m), self.added_mass_at(y[0])
 
-    # -- participant protocol -------------------------------------------------------------
-    @property
-    def time(self) -> float:
-        return self._t
-
-    @property
-    def state(self) -> np.ndarray:
-        """(θ, θ')."""
-        return self._y.copy()
-
-    def save_state(self) -> tuple[float, np.ndarray]:
-        return (self._t, self._y.copy())
-
-    def restore_state(self, s: tuple[float, np.ndarray]) -> None:
-        self._t, y = s
-        self._y = np.array(y, dtype=float)
-
+    # -- participant protocol (time, state, save_state, restore_state: _OdeState) ----------
     def added_mass(self) -> np.ndarray:
         return self.added_mass_at(self._y[0])
 
@@ -424,7 +432,7 @@ class PendulumSlosh:
 # --------------------------------------------------------------------------------------------
 
 
-class RigidTankVehicle:
+class RigidTankVehicle(_OdeState):
     """Base of the vehicle emulators: a rigid tank driven by n generalized coordinates q.
 
     Subclasses give the mass M(q), the applied forces Q(t, q, q'), the tank kinematics
@@ -474,23 +482,7 @@ class RigidTankVehicle:
         acc = J @ qdd + j0
         return {"acceleration": acc[:3], "angular_velocity": w, "angular_acceleration": acc[3:], "gravity": g}
 
-    # -- participant protocol -------------------------------------------------------------
-    @property
-    def time(self) -> float:
-        return self._t
-
-    @property
-    def state(self) -> np.ndarray:
-        """(q, q')."""
-        return self._y.copy()
-
-    def save_state(self) -> tuple[float, np.ndarray]:
-        return (self._t, self._y.copy())
-
-    def restore_state(self, s: tuple[float, np.ndarray]) -> None:
-        self._t, y = s
-        self._y = np.array(y, dtype=float)
-
+    # -- participant protocol (time, state, save_state, restore_state: _OdeState) ----------
     def set_added_mass(self, added_mass: np.ndarray | None) -> None:
         if added_mass is None:
             self._ma = None

@@ -153,18 +153,31 @@ impl SloshRun {
     /// [`SloshRun::run_to`] calling `observe` after every accepted step; the run stops
     /// (with [`crate::vehicle::stopped_by_observer`]) when it returns `false`.
     pub fn run_to_observed(&mut self, t_end: f64, h: f64, observe: Observer<'_>) -> Result<(), Box<SloshFailure>> {
+        self.step_loop(t_end, h, observe, None)
+    }
+
+    /// The step loop of every run method: step, record, append the sample to `journal` (if
+    /// any), write a due checkpoint, and ask `observe` whether to go on.
+    fn step_loop(
+        &mut self,
+        t_end: f64,
+        h: f64,
+        observe: Observer<'_>,
+        mut journal: Option<&mut Journal>,
+    ) -> Result<(), Box<SloshFailure>> {
+        let fail = |run: &Self, error| Box::new(SloshFailure { error, record: run.record.clone() });
         while t_end - self.hht.t() > 1e-12 * (1.0 + t_end.abs()) {
             let h_step = h.min(t_end - self.hht.t());
             match self.hht.step(h_step) {
                 Ok(info) => self.record_state(info.iterations),
-                Err(error) => return Err(Box::new(SloshFailure { error, record: self.record.clone() })),
+                Err(error) => return Err(fail(self, error)),
             }
-            if let Err(error) = self.checkpoint_if_due() {
-                return Err(Box::new(SloshFailure { error, record: self.record.clone() }));
+            if let Some(j) = journal.as_deref_mut() {
+                j.append(&self.record.row(self.record.t.len() - 1)).map_err(|e| fail(self, e))?;
             }
+            self.checkpoint_if_due().map_err(|e| fail(self, e))?;
             if !observe(&Progress::of(&self.hht, t_end)) {
-                let error = crate::vehicle::stopped_by_observer(self.hht.t());
-                return Err(Box::new(SloshFailure { error, record: self.record.clone() }));
+                return Err(fail(self, crate::vehicle::stopped_by_observer(self.hht.t())));
             }
         }
         Ok(())
@@ -186,18 +199,7 @@ impl SloshRun {
         while journal.rows() < self.record.t.len() {
             journal.append(&self.record.row(journal.rows())).map_err(|e| fail(self, e))?;
         }
-        while t_end - self.hht.t() > 1e-12 * (1.0 + t_end.abs()) {
-            let h_step = h.min(t_end - self.hht.t());
-            match self.hht.step(h_step) {
-                Ok(info) => self.record_state(info.iterations),
-                Err(error) => return Err(fail(self, error)),
-            }
-            journal.append(&self.record.row(self.record.t.len() - 1)).map_err(|e| fail(self, e))?;
-            self.checkpoint_if_due().map_err(|e| fail(self, e))?;
-            if !observe(&Progress::of(&self.hht, t_end)) {
-                return Err(fail(self, crate::vehicle::stopped_by_observer(self.hht.t())));
-            }
-        }
+        self.step_loop(t_end, h, observe, Some(&mut *journal))?;
         journal.flush().map_err(|e| fail(self, e))
     }
 
