@@ -9,6 +9,10 @@
 //! GEMMs 2·3NPT·32·6 + 2·32·3NPT·3, plus ≈350 flops per viscous point and ≈250 per
 //! penalty point for the stress update; the Jacobian adds ≈127 kflop per point
 //! (two 96×96 rank-9 accumulations and 18 directional derivatives).
+//! A second table times one element's force + Jacobians through the structured
+//! volumetric tangent (`ElementRef::internal_force`, the default) and through the generic
+//! per-point 9×9 tangent path (`ElementRef::internal_force_generic`), alternated in the same
+//! run over the first 64 elements, median of the repetitions.
 //! Pass a filter argument (e.g. `cargo bench --bench element -- quick`) for fewer repetitions.
 
 use std::hint::black_box;
@@ -85,6 +89,53 @@ fn main() {
                 t_s / t_b,
                 1e6 * t_j / nel,
                 flops_j * nel / t_j / 1e9,
+            );
+        }
+    }
+    println!();
+    println!("force + Jacobians of one element (64 elements per repetition), 1 thread, median of {reps}");
+    println!("{:<30} {:>6} {:>16} {:>16} {:>9}", "fluid", "rule", "structured us/el", "generic us/el", "speedup");
+    for fluid in fluids {
+        for (nv, np) in [(3, 2), (3, 3), (3, 4)] {
+            let body =
+                FluidBody::new(mesh.clone(), fluid, QuadratureOptions { viscous: nv, penalty: np, mass: 4 }).unwrap();
+            let mut rng = Rng::new(2);
+            let e: Vec<f64> = body.reference_coordinates().iter().map(|x| x + 0.002 * rng.uniform()).collect();
+            let v: Vec<f64> = e.iter().map(|_| 0.1 * rng.uniform()).collect();
+            let els: Vec<_> =
+                (0..64).map(|el| (body.element_coordinates(el, &e), body.element_coordinates(el, &v))).collect();
+            let mut f = [0.0; ancf_core::shape::N_COORDS];
+            let mut k = vec![0.0; ancf_core::shape::N_COORDS * ancf_core::shape::N_COORDS];
+            let mut c = k.clone();
+            let mut run = |generic: bool| {
+                let t = Instant::now();
+                for (el, (ec, vc)) in els.iter().enumerate() {
+                    let r = &body.elements[el];
+                    let jac = Some((k.as_mut_slice(), c.as_mut_slice()));
+                    if generic {
+                        r.internal_force_generic(el, &body.fluid, &body.tables, ec, vc, &mut f, jac).unwrap();
+                    } else {
+                        r.internal_force(el, &body.fluid, &body.tables, ec, vc, &mut f, jac).unwrap();
+                    }
+                    black_box(&f);
+                }
+                t.elapsed().as_secs_f64() / els.len() as f64
+            };
+            run(false);
+            run(true);
+            let (mut ts, mut tg) = (Vec::new(), Vec::new());
+            for _ in 0..reps {
+                ts.push(run(false));
+                tg.push(run(true));
+            }
+            let (ts, tg) = (median(ts), median(tg));
+            println!(
+                "{:<30} {:>6} {:>16.1} {:>16.1} {:>8.2}x",
+                format!("{} (rho {})", fluid.rheology.name(), fluid.density),
+                format!("{nv}^3+{np}^3"),
+                1e6 * ts,
+                1e6 * tg,
+                tg / ts
             );
         }
     }
