@@ -327,6 +327,42 @@ def run_fluid_train(
     progress: _Progress | None = None,
     stream: str | None = None,
 ) -> dict[str, Any]: ...
+def run_equivalent_train(
+    track: list[list[float]],
+    *,
+    cars: int = 1,
+    station: float = 50.0,
+    speed: float = 0.0,
+    t_end: float = 1.0,
+    step: float = 1e-3,
+    record_every: float = 0.01,
+    drive_speed: float | None = None,
+    brake_times: list[float] | None = None,
+    brake_torques: list[float] | None = None,
+    brake_scope: str = "all",
+    brake_factors: list[float] | None = None,
+    oil: str = "light",
+    fluid: Fluid | None = None,
+    fill: float = 0.5,
+    bulkheads: list[tuple[float, float]] | None = None,
+    slosh_axis: str = "longitudinal",
+    lading_mass: float = 0.0,
+    lading_height: float = 0.0,
+    wheel_profile: str = "s1002",
+    car: dict[str, float] | None = None,
+    progress: _Progress | None = None,
+    stream: str | None = None,
+) -> dict[str, Any]: ...
+def equivalent_model(
+    fill: float = 0.5,
+    *,
+    oil: str = "light",
+    fluid: Fluid | None = None,
+    bulkheads: list[tuple[float, float]] | None = None,
+    slosh_axis: str = "longitudinal",
+    car: dict[str, float] | None = None,
+) -> dict[str, Any]: ...
+def equivalent_lambda(depth_fraction: float) -> float: ...
 
 # --- co-simulation: the slosh participant (rail_mbs::cosim, issue 6) ---
 

@@ -196,6 +196,12 @@ def _cmd_run(args: argparse.Namespace) -> int:
     out = Path(args.out) if args.out else Path("out") / Path(args.scene).stem
     out.mkdir(parents=True, exist_ok=True)
     print(f"railslosh run: {sc.name or Path(args.scene).stem} ({sc.kind}, t_end = {sc.t_end:g} s) -> {out}")
+    choice = None
+    if sc.kind != "slosh":
+        from railslosh import fluid_model
+
+        choice = fluid_model.decide(sc)
+        print(f"  fluid model: {choice.model} ({choice.reason})")
     bar = None if args.quiet else ProgressBar()
     status = 0
     t0 = time.perf_counter()
@@ -230,6 +236,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
         "stats": dict(st),
         "error": res.get("error"),
     }
+    if choice is not None:
+        summary |= {"fluid_model": choice.model, "fluid_model_reason": choice.reason}
     (out / "run.json").write_text(json.dumps(summary, indent=1, default=str), encoding="utf-8")
     print(
         f"  {st.get('steps', 0)} steps, {st.get('newton_iterations', 0)} Newton iterations, "

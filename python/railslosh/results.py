@@ -47,6 +47,14 @@ VARIABLES: dict[str, tuple[tuple[str, ...], str, str, str, dict[str, str]]] = {
     "oil_com_global": (("car", "component"), "m", "global", "liquid centre of mass", {}),
     "fluid_force_tank": (("car", "component"), "N", "tank", "force of the liquid on the tank", {}),
     "volume_error": (("car",), "1", "", "relative liquid volume change", {}),
+    # equivalent (pendulum) slosh model runs
+    "slosh_displacement": (
+        ("car", "mode"),
+        "m",
+        "tank",
+        "displacement of each slosh mass from rest along the slosh axis",
+        {},
+    ),
     # slosh runs
     "force_tank": (("component",), "N", "tank", "force of the liquid on the tank", {}),
     "moment_tank": (("component",), "N m", "tank", "moment of the liquid on the tank about its origin", {}),
@@ -61,6 +69,8 @@ VARIABLES: dict[str, tuple[tuple[str, ...], str, str, str, dict[str, str]]] = {
 }
 
 _SCALARS = ("static_wheel_load", "dof", "fluid_mass", "elements")
+_CHOICE = ("fluid_model", "fluid_model_reason")
+"""The fluid model of a vehicle scene and why (:mod:`railslosh.fluid_model`), as global attributes."""
 
 
 def _scene_attrs(sc: Any) -> dict[str, Any]:
@@ -123,6 +133,9 @@ def to_dataset(res: Mapping[str, Any], scene: Any = None) -> Any:
     for k in _SCALARS:
         if k in res and res[k] is not None:
             attrs[k] = res[k]
+    for k in _CHOICE:
+        if res.get(k):
+            attrs[k] = str(res[k])
     for k, v in (res.get("stats") or {}).items():
         attrs[f"stats_{k}"] = v
     if res.get("error"):

@@ -52,6 +52,10 @@ compartment needs at least one element along the length).
 ``[outputs]``: ``snapshot_every`` (s, fluid mesh snapshots for ParaView; 0 = none), ``netcdf``,
 ``vtu``, ``plots`` (booleans, what ``railslosh run`` writes). Rigid lading, coupler overrides and
 wheelset offsets are not available with liquid cargo.
+``[fluid] slosh_model = "auto" | "ancf" | "pendulum" | "rigid"`` (default ``"auto"``) picks how the
+liquid is modelled: the ANCF continuum, the equivalent spring-mass / pendulum model
+(:func:`railslosh.vehicle.run_equivalent`) or rigid lading; ``"auto"`` applies the rule of
+:mod:`railslosh.fluid_model`. (The key is not ``model``: that names the rheology of a custom oil.)
 
 **Prescribed-motion slosh scenes** (a ``[maneuver]`` section; run with
 :func:`railslosh.slosh.run`): see :class:`SloshScene`.
@@ -133,6 +137,8 @@ _SECTIONS = ("track", "train", "brake", "lading", "car", "scene", "fluid", "mesh
 OILS = ("light", "medium", "heavy", "water", "custom")
 """Names accepted by ``[fluid] oil``."""
 _FLUID_MODELS = ("newtonian", "bingham", "herschel-bulkley", "oldroyd", "casson")
+SLOSH_MODELS = ("auto", "ancf", "pendulum", "rigid")
+"""Values of ``[fluid] slosh_model`` (see :mod:`railslosh.fluid_model`)."""
 _WHEEL_PROFILES = ("s1002", "aar1b")
 _BRAKE_SCOPES = ("all", "front")
 _MAX_SPEED = 70.0  # m/s (252 km/h)
@@ -245,6 +251,8 @@ class FluidSpec:
     bulkheads: tuple[tuple[float, float], ...] = ()
     custom: Mapping[str, Any] = field(default_factory=dict)
     """Constructor arguments of :class:`railslosh.Fluid` when ``oil = "custom"``."""
+    slosh_model: str = "auto"
+    """``[fluid] slosh_model``: ``"auto"``, ``"ancf"``, ``"pendulum"`` or ``"rigid"``."""
 
     def make_fluid(self, depth: float, element_height: float | None = None) -> Any:
         """The :class:`railslosh.Fluid` for a liquid ``depth`` m deep: penalty ``k = 1000 rho g depth``
@@ -299,6 +307,8 @@ class FluidSpec:
     def to_sections(self) -> dict[str, Any]:
         """The ``[fluid]``, ``[mesh]`` and ``[tank]`` tables of this liquid."""
         fl: dict[str, Any] = {"oil": self.oil, "fill": self.fill, **self.custom}
+        if self.slosh_model != "auto":
+            fl["slosh_model"] = self.slosh_model
         d: dict[str, Any] = {"fluid": fl, "mesh": {"counts": list(self.counts)}}
         if self.bulkheads:
             d["tank"] = {"bulkheads": [list(b) for b in self.bulkheads]}
@@ -392,6 +402,27 @@ class Scene:
             "snapshot_every": self.outputs.snapshot_every,
             "brake_factors": None if self.brake_factors is None else list(self.brake_factors),
         }
+        return kw
+
+    def equivalent_kwargs(self, slosh_axis: str) -> dict[str, Any]:
+        """Keyword arguments of :func:`railslosh.vehicle.run_equivalent` (after the track): the liquid
+        as its equivalent slosh model along ``slosh_axis``."""
+        kw = self.fluid_kwargs()
+        for k in ("counts", "snapshot_every"):
+            kw.pop(k)
+        kw["slosh_axis"] = slosh_axis
+        return kw
+
+    def rigid_kwargs(self) -> dict[str, Any]:
+        """Keyword arguments of :func:`railslosh.vehicle.run` (after the track) with the liquid as rigid
+        lading: its mass at its rest centroid height."""
+        if self.fluid is None:
+            return self.run_kwargs()
+        f = self.fluid
+        geo = vehicle.equivalent_model(f.fill, bulkheads=list(f.bulkheads) or None, car=dict(self.car) or None)
+        kw = self.run_kwargs()
+        kw["lading_mass"] = f.mass({**_car_defaults(), **self.car})
+        kw["lading_height"] = float(geo["centroid"][2])
         return kw
 
     def tank_radius(self) -> float:
@@ -741,9 +772,10 @@ def _bulkheads(value: Any, fieldname: str, half_length: float, n_length: int) ->
 
 def _fluid_spec(data: Mapping[str, Any], params: Mapping[str, float]) -> FluidSpec:
     fl = _table(data["fluid"], "fluid")
-    _check_keys(fl, "fluid", ("oil", "fill", "model", *_CUSTOM_KEYS))
+    _check_keys(fl, "fluid", ("oil", "fill", "model", "slosh_model", *_CUSTOM_KEYS))
     oil, custom = _fluid_section(fl)
     fill = _number(fl.get("fill", 0.5), "fluid.fill", 0.1, 0.9, "(volume fraction)")
+    slosh_model = _choice(fl.get("slosh_model", "auto"), "fluid.slosh_model", SLOSH_MODELS)
     ms = _table(data.get("mesh", {}), "mesh")
     _check_keys(ms, "mesh", ("counts",))
     counts = _counts(ms.get("counts", [6, 4, 2]), "mesh.counts", ((1, 40), (2, 20), (1, 10)))
@@ -751,7 +783,7 @@ def _fluid_spec(data: Mapping[str, Any], params: Mapping[str, float]) -> FluidSp
     _check_keys(tk, "tank", ("bulkheads",))
     half = 0.5 * (params["tank_length"] - 1.0)
     bulkheads = _bulkheads(tk.get("bulkheads", []), "tank.bulkheads", half, counts[0])
-    spec = FluidSpec(oil=oil, fill=fill, counts=counts, bulkheads=bulkheads, custom=custom)
+    spec = FluidSpec(oil=oil, fill=fill, counts=counts, bulkheads=bulkheads, custom=custom, slosh_model=slosh_model)
     if oil == "custom":
         spec.make_fluid(2.0 * params["tank_radius"] * fill)  # validates the custom fluid now
     return spec
@@ -1208,16 +1240,32 @@ def run_scene(
 
     ``progress(t, t_end, steps, newton_iterations, rejected_steps)`` is called during the run (about
     every 0.5 s of wall time); if it raises, the run stops and the exception propagates.
+    Vehicle scenes with liquid cargo run the fluid model of :func:`railslosh.fluid_model.decide`
+    (``[fluid] slosh_model``); every vehicle result carries ``fluid_model`` and ``fluid_model_reason``.
     Raises :class:`railslosh.slosh.SimulationError` when the run stops early."""
-    from railslosh import slosh
+    from railslosh import fluid_model, slosh
 
     sc = scene if isinstance(scene, Scene | SloshScene) else load_scene(scene)
     if isinstance(sc, SloshScene):
         args, kw = sc.run_args()
         res = slosh.run(*args, **kw, progress=progress)
-    elif sc.fluid is not None:
-        res = vehicle.run_fluid(np.asarray(sc.track_rows, dtype=float), **sc.fluid_kwargs(), progress=progress)
-    else:
-        res = vehicle.run(np.asarray(sc.track_rows, dtype=float), **sc.run_kwargs(), progress=progress)
+        res["scene"] = sc
+        return res
+    choice = fluid_model.decide(sc)
+    rows = np.asarray(sc.track_rows, dtype=float)
+    try:
+        if sc.fluid is None:
+            res = vehicle.run(rows, **sc.run_kwargs(), progress=progress)
+        elif choice.model == "ancf":
+            res = vehicle.run_fluid(rows, **sc.fluid_kwargs(), progress=progress)
+        elif choice.model == "pendulum":
+            res = vehicle.run_equivalent(rows, **sc.equivalent_kwargs(choice.axis or "longitudinal"), progress=progress)
+        else:
+            res = vehicle.run(rows, **sc.rigid_kwargs(), progress=progress)
+    except slosh.SimulationError as exc:
+        exc.results.update(fluid_model=choice.model, fluid_model_reason=choice.reason)
+        raise
+    res["fluid_model"] = choice.model
+    res["fluid_model_reason"] = choice.reason
     res["scene"] = sc
     return res

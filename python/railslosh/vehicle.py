@@ -25,7 +25,15 @@ import numpy as np
 from railslosh import _core
 from railslosh.slosh import SimulationError
 
-__all__ = ["design_brake_torque", "read_stream", "run", "run_fluid", "tank_car_parameters"]
+__all__ = [
+    "design_brake_torque",
+    "equivalent_model",
+    "read_stream",
+    "run",
+    "run_equivalent",
+    "run_fluid",
+    "tank_car_parameters",
+]
 
 
 def tank_car_parameters(car: dict[str, float] | None = None, wheel_profile: str = "s1002") -> dict[str, float]:
@@ -205,8 +213,104 @@ def run_fluid(
     return _raise_on_error(res, "fluid vehicle run")
 
 
+SLOSH_AXES = ("longitudinal", "lateral")
+"""Directions the equivalent slosh model can represent (one per run)."""
+
+
+def equivalent_model(
+    fill: float = 0.5,
+    *,
+    oil: str = "light",
+    fluid: Any = None,
+    bulkheads: Sequence[tuple[float, float]] | None = None,
+    slosh_axis: str = "longitudinal",
+    car: dict[str, float] | None = None,
+) -> dict[str, Any]:
+    """The equivalent spring-mass / pendulum model of one car's liquid (``rail_mbs::vehicle::equivalent``):
+    liquid ``mass``, ``depth``, ``depth_fraction``, ``lambda``, rest ``centroid`` (tank frame) and one
+    entry of ``modes`` per compartment (``mass`` m1, ``fixed_mass`` m0, ``omega``, ``frequency``,
+    ``damping_ratio``, ``position``, ``pendulum_length``, ``compartment_length``). ``fill`` is the liquid
+    volume fraction, as in :func:`run_fluid`."""
+    return dict(
+        _core.equivalent_model(
+            fill,
+            oil=oil,
+            fluid=fluid,
+            bulkheads=None if bulkheads is None else [(float(x), float(t)) for x, t in bulkheads],
+            slosh_axis=slosh_axis,
+            car=car,
+        )
+    )
+
+
+def run_equivalent(
+    track: Any,
+    *,
+    cars: int = 1,
+    station: float = 300.0,
+    speed: float = 0.0,
+    t_end: float = 1.0,
+    step: float = 4e-3,
+    record_every: float = 0.02,
+    drive: bool | float = False,
+    brake: tuple[Sequence[float], Sequence[float]] | None = None,
+    brake_scope: str = "all",
+    brake_factors: Sequence[float] | None = None,
+    oil: str = "light",
+    fluid: Any = None,
+    fill: float = 0.5,
+    bulkheads: Sequence[tuple[float, float]] | None = None,
+    slosh_axis: str = "longitudinal",
+    lading_mass: float = 0.0,
+    lading_height: float = 0.0,
+    wheel_profile: str = "s1002",
+    car: dict[str, float] | None = None,
+    progress: Callable[[float, float, int, int, int], object] | None = None,
+    stream: str | os.PathLike[str] | None = None,
+) -> dict[str, Any]:
+    """Run tank cars whose liquid is its equivalent mechanical model: per compartment one slosh mass
+    on a spring (``slosh_axis = "longitudinal"``, braking) or one pendulum hinged on the tank axis
+    (``"lateral"``, curving), the rest of the liquid carried rigidly (see :func:`equivalent_model`).
+    Arguments as :func:`run_fluid` (``fill`` is the volume fraction; ``fluid`` gives density and plastic
+    viscosity, yield stresses are ignored). Returns the arrays of :func:`run` plus ``oil_com_tank``
+    (samples, cars, 3; liquid centre of mass in the tank frame, as :func:`run_fluid`),
+    ``slosh_displacement`` (samples, cars, modes; m, along the slosh axis), ``fluid_mass`` and
+    ``equivalent_model``."""
+    if slosh_axis not in SLOSH_AXES:
+        raise ValueError(f"invalid parameter `slosh_axis` = {slosh_axis!r}: allowed one of {', '.join(SLOSH_AXES)}")
+    drive_speed, times, torques = _drive_and_brake(drive, speed, brake)
+    res = dict(
+        _core.run_equivalent_train(
+            _table(track),
+            cars=cars,
+            station=station,
+            speed=speed,
+            t_end=t_end,
+            step=step,
+            record_every=record_every,
+            drive_speed=drive_speed,
+            brake_times=times,
+            brake_torques=torques,
+            brake_scope=brake_scope,
+            brake_factors=None if brake_factors is None else list(map(float, brake_factors)),
+            oil=oil,
+            fluid=fluid,
+            fill=fill,
+            bulkheads=None if bulkheads is None else [(float(x), float(t)) for x, t in bulkheads],
+            slosh_axis=slosh_axis,
+            lading_mass=lading_mass,
+            lading_height=lading_height,
+            wheel_profile=wheel_profile,
+            car=car,
+            progress=progress,
+            stream=None if stream is None else os.fspath(stream),
+        )
+    )
+    return _raise_on_error(res, "equivalent-slosh vehicle run")
+
+
 def read_stream(path: str | os.PathLike[str]) -> dict[str, Any]:
-    """The samples of a :func:`run` or :func:`run_fluid` ``stream`` file (also of an interrupted
+    """The samples of a :func:`run`, :func:`run_fluid` or :func:`run_equivalent` ``stream`` file (also of an interrupted
     run: every complete sample), as arrays shaped like the run's results: ``t``,
     ``wheel_vertical`` and ``wheel_lateral`` (samples, wheelsets, [left, right]),
     ``wheelset_lateral``, ``coupler_force``, ``tank_station``, ``tank_speed`` and, for fluid runs,

@@ -71,3 +71,31 @@ fn bad_scenario_input_names_the_field() {
     let e = build_train(&sc).unwrap_err().to_string();
     assert!(e.contains("wheelbase"), "{e}");
 }
+
+#[test]
+fn coupler_faces_stay_at_the_coupler_height_with_rigid_lading_off_the_axis() {
+    // Rigid lading below the tank axis moves the tank body's centre of mass (its frame origin)
+    // down; the coupler must stay at `coupler_height` above the rail (regression: it moved
+    // down with the centre of mass). The face height is read from the coupler's wrench on the
+    // front tank after pulling the rear car back: arm_z = M_y / F_x.
+    for lading in [None, Some((40_000.0, -0.6)), Some((20_000.0, 0.4))] {
+        let mut p = TankCarParams::standard().unwrap();
+        p.lading = lading;
+        let mut sc = TrainScenario::single(p.clone(), tangent(), 100.0, 0.0, 1.0);
+        sc.cars = 2;
+        let (mb, cars, couplers) = build_train(&sc).unwrap();
+        let coupler = &mb.forces()[couplers[0]];
+        let front = mb.initial_state(Some(cars[0].tank));
+        let mut rear = mb.initial_state(Some(cars[1].tank));
+        rear.position.x -= 1e-3; // pull apart: tension
+        let [wf, _] = coupler.wrenches(0.0, &front, &rear);
+        assert!(wf.force.x.abs() > 1e3, "{:?}", wf.force);
+        let arm_z = wf.moment.y / wf.force.x;
+        let face_height = front.position.z + arm_z;
+        assert!(
+            (face_height - p.coupler_height).abs() < 1e-6,
+            "lading {lading:?}: coupler face at {face_height} m, expected {} m",
+            p.coupler_height
+        );
+    }
+}

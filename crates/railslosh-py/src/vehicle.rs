@@ -12,7 +12,8 @@ use rail_mbs::profile::aar1b_wheel_approx;
 use rail_mbs::track::{Track, TrackPoint};
 use rail_mbs::vehicle::studies::{Oil, brake_torque};
 use rail_mbs::vehicle::{
-    BrakeScope, FluidCargo, FluidTrainRecord, TankCarParams, TrainRecord, TrainScenario,
+    BrakeScope, EquivalentCargo, EquivalentModel, EquivalentTrainRecord, FluidCargo, FluidTrainRecord, SloshAxis,
+    TankCarParams, TrainRecord, TrainScenario, run_equivalent_train_streamed as rust_run_equivalent_train,
     run_fluid_train_streamed as rust_run_fluid_train, run_train_streamed as rust_run_train,
 };
 
@@ -377,11 +378,189 @@ pub fn run_fluid_train<'py>(
     }
 }
 
+fn slosh_axis_of(name: &str) -> PyResult<SloshAxis> {
+    match name {
+        "longitudinal" => Ok(SloshAxis::Longitudinal),
+        "lateral" => Ok(SloshAxis::Lateral),
+        other => Err(crate::to_py(invalid("slosh_axis", other, "'longitudinal' or 'lateral'"))),
+    }
+}
+
+/// The equivalent cargo of a named oil (or a `railslosh.Fluid`).
+fn equivalent_cargo(
+    oil: &str,
+    fluid: Option<Bound<'_, crate::PyFluid>>,
+    fill: f64,
+    bulkheads: Option<Vec<(f64, f64)>>,
+    slosh_axis: &str,
+) -> PyResult<EquivalentCargo> {
+    let axis = slosh_axis_of(slosh_axis)?;
+    let bulkheads = bulkheads.unwrap_or_default();
+    Ok(match fluid {
+        Some(f) => EquivalentCargo::from_fluid(&f.get().inner, fill, bulkheads, axis),
+        None => {
+            let (rho, mu, _) = oil_of(oil)?.properties();
+            EquivalentCargo::new(rho, mu, fill, bulkheads, axis)
+        }
+    })
+}
+
+fn model_dict<'py>(py: Python<'py>, m: &EquivalentModel) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item(
+        "slosh_axis",
+        match m.axis {
+            SloshAxis::Longitudinal => "longitudinal",
+            SloshAxis::Lateral => "lateral",
+        },
+    )?;
+    d.set_item("mass", m.mass)?;
+    d.set_item("depth", m.depth)?;
+    d.set_item("depth_fraction", m.depth_fraction)?;
+    d.set_item("lambda", m.lambda)?;
+    d.set_item("equivalent_depth", m.equivalent_depth)?;
+    d.set_item("centroid", m.centroid.to_vec())?;
+    let modes = pyo3::types::PyList::empty(py);
+    for (s, c) in m.modes.iter().zip(&m.compartments) {
+        let e = PyDict::new(py);
+        e.set_item("mass", s.mass)?;
+        e.set_item("fixed_mass", s.fixed_mass)?;
+        e.set_item("omega", s.omega)?;
+        e.set_item("frequency", s.omega / (2.0 * std::f64::consts::PI))?;
+        e.set_item("damping_ratio", s.damping_ratio)?;
+        e.set_item("position", s.position.to_vec())?;
+        e.set_item("fixed_position", s.fixed_position.to_vec())?;
+        e.set_item("pendulum_length", s.pendulum_length)?;
+        e.set_item("compartment_mass", c.mass)?;
+        e.set_item("compartment_length", c.length)?;
+        modes.append(e)?;
+    }
+    d.set_item("modes", modes)?;
+    Ok(d)
+}
+
+/// `λ = ω₁²R/g` of a horizontal circular cylinder at liquid depth fraction `h/2R` (the Rust
+/// table of `rail_mbs::vehicle::equivalent`, interpolated).
+#[pyfunction]
+pub fn equivalent_lambda(py: Python<'_>, depth_fraction: f64) -> PyResult<f64> {
+    compute(py, move || rail_mbs::vehicle::equivalent::cylinder_lambda(depth_fraction))
+}
+
+/// The equivalent slosh model (masses, frequencies, damping ratios, positions) of the liquid
+/// of one car: `fill` is the volume fraction, as in `run_fluid_train`.
+#[pyfunction]
+#[pyo3(signature = (fill=0.5, *, oil="light", fluid=None, bulkheads=None, slosh_axis="longitudinal", car=None))]
+pub fn equivalent_model<'py>(
+    py: Python<'py>,
+    fill: f64,
+    oil: &str,
+    fluid: Option<Bound<'py, crate::PyFluid>>,
+    bulkheads: Option<Vec<(f64, f64)>>,
+    slosh_axis: &str,
+    car: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let params = car_params(car, "s1002")?;
+    let cargo = equivalent_cargo(oil, fluid, fill, bulkheads, slosh_axis)?;
+    let m = compute(py, move || cargo.model(&params, rail_mbs::track::GRAVITY))?;
+    model_dict(py, &m)
+}
+
+fn equivalent_record_dict<'py>(py: Python<'py>, r: &EquivalentTrainRecord) -> PyResult<Bound<'py, PyDict>> {
+    let d = record_dict(py, &r.train)?;
+    let nt = r.oil_com_tank.len();
+    let nc = r.oil_com_tank.first().map_or(0, |x| x.len());
+    let com: Vec<f64> = r.oil_com_tank.iter().flat_map(|s| s.iter().flat_map(|c| c.iter().copied())).collect();
+    d.set_item("oil_com_tank", arr(py, com, &[nt, nc, 3])?)?;
+    let nm = r.model.as_ref().map_or(0, |m| m.modes.len());
+    let disp: Vec<f64> = r.slosh_displacement.iter().flat_map(|s| s.iter().flatten().copied()).collect();
+    d.set_item("slosh_displacement", arr(py, disp, &[nt, nc, nm])?)?;
+    if let Some(m) = &r.model {
+        d.set_item("fluid_mass", m.mass)?;
+        d.set_item("equivalent_model", model_dict(py, m)?)?;
+    }
+    Ok(d)
+}
+
+/// Runs a train whose tanks carry the equivalent spring–mass / pendulum model of their
+/// liquid (`rail_mbs::vehicle::equivalent`): one slosh mass per compartment along
+/// `slosh_axis` (`"longitudinal"` or `"lateral"`). Returns the `run_train` arrays plus the
+/// liquid centre of mass in the tank frame, the slosh displacements and the model.
+#[pyfunction]
+#[pyo3(signature = (
+    track, *, cars=1, station=50.0, speed=0.0, t_end=1.0, step=1e-3, record_every=0.01,
+    drive_speed=None, brake_times=None, brake_torques=None, brake_scope="all", brake_factors=None,
+    oil="light", fluid=None, fill=0.5, bulkheads=None, slosh_axis="longitudinal",
+    lading_mass=0.0, lading_height=0.0, wheel_profile="s1002", car=None, progress=None, stream=None
+))]
+#[allow(clippy::too_many_arguments)]
+pub fn run_equivalent_train<'py>(
+    py: Python<'py>,
+    track: Vec<Vec<f64>>,
+    cars: usize,
+    station: f64,
+    speed: f64,
+    t_end: f64,
+    step: f64,
+    record_every: f64,
+    drive_speed: Option<f64>,
+    brake_times: Option<Vec<f64>>,
+    brake_torques: Option<Vec<f64>>,
+    brake_scope: &str,
+    brake_factors: Option<Vec<f64>>,
+    oil: &str,
+    fluid: Option<Bound<'py, crate::PyFluid>>,
+    fill: f64,
+    bulkheads: Option<Vec<(f64, f64)>>,
+    slosh_axis: &str,
+    lading_mass: f64,
+    lading_height: f64,
+    wheel_profile: &str,
+    car: Option<&Bound<'py, PyDict>>,
+    progress: Option<Py<PyAny>>,
+    stream: Option<std::path::PathBuf>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let mut params = car_params(car, wheel_profile)?;
+    if lading_mass != 0.0 {
+        params.lading = Some((lading_mass, lading_height));
+    }
+    let cargo = equivalent_cargo(oil, fluid, fill, bulkheads, slosh_axis)?;
+    let modes = compute(py, || cargo.model(&params, rail_mbs::track::GRAVITY))?.modes.len();
+    let brake = brake_of(brake_times, brake_torques, brake_scope)?;
+    let track = Arc::new(track_from_table(track).map_err(crate::to_py)?);
+    let mut sc = TrainScenario::single(params, track, station, speed, t_end);
+    sc.cars = cars;
+    sc.step = step;
+    sc.record_every = record_every;
+    sc.drive = drive_speed.map(SpeedProfile::Constant);
+    sc.brake = brake;
+    sc.brake_factors = brake_factors.unwrap_or_default();
+    let mut observer = PyProgress::new(progress);
+    let obs = &mut observer;
+    let columns = EquivalentTrainRecord::columns(4 * sc.cars, sc.cars.saturating_sub(1), sc.cars, modes);
+    let out = compute(py, move || {
+        let mut journal = open_stream(stream.as_deref(), &columns)?;
+        let mut sink = |row: &[f64]| journal.as_mut().map_or(Ok(()), |j| j.append(row));
+        rust_run_equivalent_train(&sc, &cargo, &mut |p| obs.observe(p), Some(&mut sink))
+    })?;
+    observer.finish()?;
+    match out {
+        Ok(r) => equivalent_record_dict(py, &r),
+        Err(f) => {
+            let d = equivalent_record_dict(py, &f.record)?;
+            d.set_item("error", f.error.to_string())?;
+            Ok(d)
+        }
+    }
+}
+
 /// Registers the vehicle functions.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(tank_car_parameters, m)?)?;
     m.add_function(wrap_pyfunction!(run_train, m)?)?;
     m.add_function(wrap_pyfunction!(run_fluid_train, m)?)?;
     m.add_function(wrap_pyfunction!(design_brake_torque, m)?)?;
+    m.add_function(wrap_pyfunction!(run_equivalent_train, m)?)?;
+    m.add_function(wrap_pyfunction!(equivalent_model, m)?)?;
+    m.add_function(wrap_pyfunction!(equivalent_lambda, m)?)?;
     Ok(())
 }

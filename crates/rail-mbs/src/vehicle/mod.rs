@@ -33,12 +33,17 @@
 //! rate `V κ`, and — wheelsets — the rolling spin `V / r₀`. The front of the car (bogie
 //! 1, coupler end A) points towards increasing `s`.
 
+pub mod equivalent;
 pub mod fluid;
 mod run;
 pub mod studies;
 mod tank_car;
 pub mod validate;
 
+pub use equivalent::{
+    EquivalentCargo, EquivalentModel, EquivalentTrainFailure, EquivalentTrainRecord, SloshAxis, build_equivalent_train,
+    run_equivalent_train, run_equivalent_train_streamed,
+};
 pub use fluid::{
     FluidCargo, FluidTrainFailure, FluidTrainRecord, FluidVehicle, TankFluid, build_fluid_train, run_fluid_train,
     run_fluid_train_observed, run_fluid_train_streamed,

@@ -188,6 +188,12 @@ impl TankCarParams {
         })
     }
 
+    /// Height of the tank body's centre of mass (its frame origin) above the tank axis, m:
+    /// nonzero with rigid lading off the axis.
+    pub fn tank_origin_above_axis(&self) -> f64 {
+        self.lading.map_or(0.0, |(m, h)| m * h / (self.tank.mass + m).max(1e-300))
+    }
+
     /// Total mass of the car, kg.
     pub fn total_mass(&self) -> f64 {
         self.tank.mass
@@ -469,7 +475,7 @@ pub fn add_tank_car(
             None => p.tank.inertia,
         },
     };
-    let lading_shift = p.lading.map_or(0.0, |(m, h)| m * h / tank_mass.mass.max(1e-300));
+    let lading_shift = p.tank_origin_above_axis();
     let tank =
         mb.add_body(place.body(format!("{name}/tank"), tank_mass, station, 0.0, p.tank_axis_height + lading_shift))?;
     let half = 0.5 * p.truck_centers;
@@ -619,7 +625,9 @@ pub fn add_coupler(
 ) -> Result<usize, AncfError> {
     let sf = mb.initial_state(Some(front.tank));
     let sr = mb.initial_state(Some(rear.tank));
-    let z = params.coupler_height - params.tank_axis_height;
+    // Tank-body points are relative to its centre of mass, which rigid lading moves off the
+    // axis; the coupler stays at its height above the rail.
+    let z = params.coupler_height - params.tank_axis_height - params.tank_origin_above_axis();
     let pf = Vector3::new(-params.coupler_reach, 0.0, z);
     let pr = Vector3::new(params.coupler_reach, 0.0, z);
     let free_length = (sr.point(&pr) - sf.point(&pf)).norm();
