@@ -328,7 +328,14 @@ fn failure_causes_classify_every_error_and_messages_keep_the_words_python_matche
     let inverted = sys(SystemError::InvertedElement { element: 3, point: 7, j: -0.02 });
     let penetration = sys(SystemError::Penetration { contact: "wall".into(), depth: 0.02, limit: 0.01 });
     let volume = sys(SystemError::VolumeError { what: "fluid".into(), volume: 0.98, reference: 1.0, limit: 0.01 });
-    let newton = IntegratorError::NewtonDivergence { t: 0.2, h: 0.01, iterations: 6, correction: 3.0, rate: 1.5 };
+    let newton = IntegratorError::NewtonDivergence {
+        t: 0.2,
+        h: 0.01,
+        iterations: 6,
+        correction: 3.0,
+        rate: 1.5,
+        largest: Some("coordinate 3 = z of body 'rod'".into()),
+    };
     let singular = IntegratorError::SingularMatrix { t: 0.0, h: 0.0, pivot_step: Some(5), unknown: None };
     // The patterns of railslosh.slosh.FAILURE_CAUSES (Python) in the Display strings.
     for (e, cause, words, t) in [
@@ -372,4 +379,33 @@ fn journaled_slosh_run_streams_every_recorded_sample_exactly() {
     plain.run_to(0.05, 0.01).unwrap();
     assert!(plain.record == run.record);
     std::fs::remove_file(&path).unwrap();
+}
+
+#[test]
+fn adaptive_steps_stretch_to_the_requested_step_instead_of_leaving_a_sliver() {
+    // A caller landing on output times asks for the remainder to the next one; when the
+    // controller's step falls just short of it, the step is stretched (≤ 1 %) so that no
+    // sliver step follows: one Newton failure on a sliver ends the run, since halving it
+    // falls below h_min at once (the 100 km/h curve runs of the crude-oil study stopped so,
+    // at t = 1.44 s - 9.3e-12 s).
+    let (mb, q0, v0) = pendulum();
+    let params = HhtParams { step_control: StepControl::Adaptive(AdaptiveParams::default()), ..HhtParams::default() };
+    let mut hht = Hht::new(mb, 0.0, q0, v0, params).unwrap();
+    for _ in 0..20 {
+        hht.step(4e-3).unwrap();
+    }
+    let t0 = hht.t();
+    let info = hht.step(4e-3 * 1.005).unwrap();
+    assert_eq!(info.h, 4e-3 * 1.005, "the step was not stretched: h = {}", info.h);
+    assert!((hht.t() - (t0 + 4e-3 * 1.005)).abs() < 1e-15);
+    // a request 2 % longer than the controller's step is not stretched
+    let info = hht.step(4e-3 * 1.02).unwrap();
+    assert!(info.h < 4e-3 * 1.02, "h = {}", info.h);
+    // nor is a request that would leave a remainder below h_min (a sliver whose first
+    // Newton failure would end the run: halving it falls below h_min at once)
+    let h_min = AdaptiveParams::default().h_min;
+    let t1 = hht.t();
+    let info = hht.step(4e-3 + 0.5 * h_min).unwrap();
+    assert_eq!(info.h, 4e-3 + 0.5 * h_min);
+    assert!((hht.t() - (t1 + 4e-3 + 0.5 * h_min)).abs() < 1e-15);
 }

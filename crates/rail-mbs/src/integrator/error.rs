@@ -202,7 +202,8 @@ pub enum IntegratorError {
     /// Newton iterations did not converge (and the step could not be reduced).
     #[error(
         "Newton iteration did not converge at t = {t} s, h = {h} s after {iterations} iterations \
-         (last WRMS correction {correction:e}, rate {rate:e})"
+         (last WRMS correction {correction:e}, rate {rate:e}){}",
+        largest.as_ref().map_or(String::new(), |w| format!("; largest correction: {w}"))
     )]
     NewtonDivergence {
         /// Start time of the step, s.
@@ -215,6 +216,9 @@ pub enum IntegratorError {
         correction: f64,
         /// Last estimated convergence rate (NaN if fewer than two iterations).
         rate: f64,
+        /// The unknown with the largest weighted correction in the last iteration, as the
+        /// system describes it ([`super::MechanicalSystem::describe_unknown`]), if any.
+        largest: Option<String>,
     },
     /// Adaptive stepping needed a step below `h_min`.
     #[error("step size {h:e} s below h_min = {h_min:e} s at t = {t} s; last failure: {cause}")]

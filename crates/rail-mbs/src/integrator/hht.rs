@@ -2,7 +2,7 @@
 
 use std::time::Instant;
 
-use super::error::{IntegratorError, Quantity, SystemError};
+use super::error::{IntegratorError, KktIndex, Quantity, SystemError};
 use super::linear::{KktSolver, LinearFailure};
 use super::params::{HhtParams, JacobianPolicy, StepControl};
 use super::stats::Stats;
@@ -110,6 +110,9 @@ pub struct Hht<S: MechanicalSystem> {
     easy_count: usize,
     stats: Stats,
 }
+
+/// An adaptive step may be lengthened by this factor to reach the requested step exactly.
+const STRETCH: f64 = 1.01;
 
 fn first_non_finite(x: &[f64]) -> Option<usize> {
     x.iter().position(|v| !v.is_finite())
@@ -469,6 +472,22 @@ impl<S: MechanicalSystem> Hht<S> {
         Ok(())
     }
 
+    /// The unknown with the largest weighted entry of the last Newton correction (still in
+    /// `rhs` after a failed attempt), described by the system.
+    fn largest_correction(&self) -> Option<String> {
+        let n = self.n;
+        let weights = self.w_a.iter().chain(&self.w_l);
+        let (i, _) = self
+            .rhs
+            .iter()
+            .zip(weights)
+            .map(|(x, w)| (x * w).abs())
+            .enumerate()
+            .filter(|(_, v)| v.is_finite())
+            .max_by(|a, b| a.1.total_cmp(&b.1))?;
+        Some(self.system.describe_unknown(KktIndex::from_raw(i, n)))
+    }
+
     fn base_mode(&self) -> RefreshMode {
         match self.params.jacobian {
             JacobianPolicy::EveryIteration => RefreshMode::EveryIteration,
@@ -483,7 +502,12 @@ impl<S: MechanicalSystem> Hht<S> {
             StepControl::Adaptive(p) => Some(p),
         };
         let mut h = match adaptive {
-            Some(_) => self.h_current.min(h_req),
+            // Stretch the controller's step by up to 1 % (or by less than h_min) rather than
+            // leave a sliver of the requested step: a caller landing on an output time would
+            // otherwise ask next for a step of, e.g., 1e-11 s, and a single Newton failure on
+            // it ends the run, because halving it falls below h_min at once.
+            Some(p) if h_req <= STRETCH * self.h_current || h_req - self.h_current < p.h_min => h_req,
+            Some(_) => self.h_current,
             None => h_req,
         };
         let mut mode = self.base_mode();
@@ -520,6 +544,7 @@ impl<S: MechanicalSystem> Hht<S> {
                         mode = RefreshMode::EveryIteration;
                         continue;
                     }
+                    let largest = if cause.is_none() && iterations > 0 { self.largest_correction() } else { None };
                     let give_up = |h: f64| {
                         cause.clone().unwrap_or(IntegratorError::NewtonDivergence {
                             t: self.t,
@@ -527,6 +552,7 @@ impl<S: MechanicalSystem> Hht<S> {
                             iterations,
                             correction,
                             rate,
+                            largest: largest.clone(),
                         })
                     };
                     let Some(p) = adaptive else {

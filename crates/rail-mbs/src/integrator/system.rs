@@ -1,6 +1,6 @@
 //! The [`MechanicalSystem`] trait: what the integrator needs from a model.
 
-use super::error::SystemError;
+use super::error::{KktIndex, SystemError};
 use super::iterative::LinearSolverKind;
 
 /// Fixed sparsity pattern of a [`MechanicalSystem`], declared once.
@@ -154,6 +154,12 @@ pub trait MechanicalSystem {
     ) -> Result<bool, SystemError> {
         let _ = (t, q, v, out);
         Ok(false)
+    }
+
+    /// Describes a KKT unknown (a coordinate's acceleration or a constraint's multiplier) for
+    /// error messages: which body, node or joint it belongs to. Default: its index.
+    fn describe_unknown(&self, index: KktIndex) -> String {
+        index.to_string()
     }
 
     /// Optional acceptance check of a converged step at `(t, q, v)`, before it is

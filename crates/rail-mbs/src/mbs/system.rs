@@ -25,7 +25,7 @@ use super::body::{Attachment, BodyId, BodyState, RigidBody};
 use super::force::{ForceElement, Wrench};
 use super::joint::{Joint, JointKind};
 use super::wheelset::{WheelsetContact, WheelsetReport};
-use crate::integrator::{MechanicalSystem, SparsityPattern, SystemError};
+use crate::integrator::{KktIndex, MechanicalSystem, SparsityPattern, SystemError};
 use ancf_core::error::{AncfError, invalid};
 
 /// Finite-difference step for coordinates (m, or Euler-parameter units).
@@ -338,6 +338,30 @@ impl MechanicalSystem for Multibody {
 
     fn n_constraints(&self) -> usize {
         self.bodies.len() + self.joints.iter().map(|j| j.n_equations()).sum::<usize>()
+    }
+
+    fn describe_unknown(&self, index: KktIndex) -> String {
+        const COMPONENTS: [&str; 7] = ["x", "y", "z", "e0", "e1", "e2", "e3"];
+        match index {
+            KktIndex::Coordinate(i) if i < 7 * self.bodies.len() => {
+                format!("coordinate {i} = {} of body '{}'", COMPONENTS[i % 7], self.bodies[i / 7].name)
+            }
+            KktIndex::Constraint(k) if k < self.bodies.len() => {
+                format!("constraint {k} = Euler-parameter normalization of body '{}'", self.bodies[k].name)
+            }
+            KktIndex::Constraint(k) => {
+                // joint rows follow the normalization rows, in joint order (see `build_layout`)
+                let mut row = self.bodies.len();
+                for j in &self.joints {
+                    if k < row + j.n_equations() {
+                        return format!("constraint {k} = equation {} of joint '{}'", k - row, j.name);
+                    }
+                    row += j.n_equations();
+                }
+                index.to_string()
+            }
+            KktIndex::Coordinate(_) => index.to_string(),
+        }
     }
 
     fn pattern(&self) -> SparsityPattern {

@@ -30,7 +30,7 @@ use ancf_core::error::AncfError;
 use ancf_core::shape::N_SHAPE;
 use nalgebra::{Matrix3, Vector3};
 
-use crate::integrator::{MechanicalSystem, SparsityPattern, SystemError};
+use crate::integrator::{KktIndex, MechanicalSystem, SparsityPattern, SystemError};
 use crate::mbs::{BodyId, BodyState, Multibody};
 
 /// Finite-difference steps for the tank coordinates and velocities.
@@ -221,6 +221,27 @@ impl MechanicalSystem for FluidVehicle {
 
     fn n_constraints(&self) -> usize {
         self.mb.n_constraints()
+    }
+
+    fn describe_unknown(&self, index: KktIndex) -> String {
+        let KktIndex::Coordinate(i) = index else { return self.mb.describe_unknown(index) };
+        if i < self.n_rigid {
+            return self.mb.describe_unknown(index);
+        }
+        const SLOTS: [&str; 4] = ["position", "gradient d/dX", "gradient d/dY", "gradient d/dZ"];
+        let mut offset = self.n_rigid;
+        for (k, f) in self.fluids.iter().enumerate() {
+            let n = f.body.n_coords();
+            if i < offset + n {
+                let local = i - offset;
+                let (node, slot, c) = (local / 12, (local % 12) / 3, ["x", "y", "z"][local % 3]);
+                return format!("coordinate {i} = {} {c} of node {node} of fluid {k} (tank '{}')", SLOTS[slot], {
+                    self.mb.bodies()[f.tank.0].name.as_str()
+                });
+            }
+            offset += n;
+        }
+        index.to_string()
     }
 
     fn pattern(&self) -> SparsityPattern {
