@@ -10,8 +10,8 @@
 //! penalty point for the stress update; the Jacobian adds ≈127 kflop per point
 //! (two 96×96 rank-9 accumulations and 18 directional derivatives).
 //! A second table times one element's force + Jacobians through the structured
-//! volumetric tangent (`ElementRef::internal_force`, the default) and through the generic
-//! per-point 9×9 tangent path (`ElementRef::internal_force_generic`), alternated in the same
+//! volumetric tangent (`VolumetricJacobian::Structured`, the default from 27 penalty points) and through the generic
+//! per-point 9×9 tangent path (`VolumetricJacobian::Generic`), alternated in the same
 //! run over the first 64 elements, median of the repetitions.
 //! Pass a filter argument (e.g. `cargo bench --bench element -- quick`) for fewer repetitions.
 
@@ -20,7 +20,7 @@ use std::time::Instant;
 
 use ancf_core::FluidBody;
 use ancf_core::constitutive::{Fluid, Rheology};
-use ancf_core::element::QuadratureOptions;
+use ancf_core::element::{QuadratureOptions, VolumetricJacobian};
 use ancf_core::mesh::box_mesh;
 use ancf_core::validate::Rng;
 
@@ -112,11 +112,8 @@ fn main() {
                 for (el, (ec, vc)) in els.iter().enumerate() {
                     let r = &body.elements[el];
                     let jac = Some((k.as_mut_slice(), c.as_mut_slice()));
-                    if generic {
-                        r.internal_force_generic(el, &body.fluid, &body.tables, ec, vc, &mut f, jac).unwrap();
-                    } else {
-                        r.internal_force(el, &body.fluid, &body.tables, ec, vc, &mut f, jac).unwrap();
-                    }
+                    let path = if generic { VolumetricJacobian::Generic } else { VolumetricJacobian::Structured };
+                    r.internal_force_with(el, &body.fluid, &body.tables, (ec, vc), &mut f, jac, path).unwrap();
                     black_box(&f);
                 }
                 t.elapsed().as_secs_f64() / els.len() as f64

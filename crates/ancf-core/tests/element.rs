@@ -3,6 +3,7 @@
 
 use ancf_core::body::rigid_motion;
 use ancf_core::constitutive::{Fluid, M3, Rheology};
+use ancf_core::element::VolumetricJacobian::{Generic, Structured};
 use ancf_core::element::{ElementRef, QuadratureOptions, ShapeTables, box_element, to_compact};
 use ancf_core::mesh::{CylinderTankSpec, EllipticCylinderSpec, box_mesh, cylinder_tank, elliptic_cylinder};
 use ancf_core::shape::{N_COORDS, N_SHAPE};
@@ -438,7 +439,7 @@ fn jacobians_without_penalty_terms_match_finite_differences() {
 #[test]
 fn structured_volumetric_jacobian_equals_the_generic_tangent_path() {
     // The penalty Jacobians assembled from their structure (rank-one terms and the cofactor
-    // derivative, `internal_force`) against the per-point 9×9 tangents (`internal_force_generic`),
+    // derivative, `internal_force_with(.., Structured)`) against the per-point 9×9 tangents (`Generic`),
     // on distorted curved elements with velocities, for every penalty rule and a
     // penalty-dominated and a viscosity-dominated fluid. Forces must be identical, Jacobians
     // equal to round-off.
@@ -460,8 +461,8 @@ fn structured_volumetric_jacobian_equals_the_generic_tangent_path() {
             let [f0, f1] = &mut f;
             let [k0, k1] = &mut kk;
             let [c0, c1] = &mut cc;
-            el.internal_force(0, &fluid, &tables, &ec, &vc, f0, Some((k0, c0))).unwrap();
-            el.internal_force_generic(0, &fluid, &tables, &ec, &vc, f1, Some((k1, c1))).unwrap();
+            el.internal_force_with(0, &fluid, &tables, (&ec, &vc), f0, Some((k0, c0)), Structured).unwrap();
+            el.internal_force_with(0, &fluid, &tables, (&ec, &vc), f1, Some((k1, c1)), Generic).unwrap();
             assert_eq!(f[0], f[1], "forces differ (penalty rule {penalty})");
             let scale_k = kk[1].iter().fold(0.0f64, |m, x| m.max(x.abs()));
             let scale_c = cc[1].iter().fold(0.0f64, |m, x| m.max(x.abs()));

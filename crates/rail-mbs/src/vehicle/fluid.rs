@@ -671,14 +671,7 @@ pub fn run_fluid_train_streamed(
     let (q0, v0) = sys.initial_coordinates();
     let start = Instant::now();
     let finish = |hht: Option<&Hht<FluidVehicle>>, mut rec: FluidTrainRecord| {
-        if let Some(h) = hht {
-            let s = h.stats();
-            rec.train.newton_iterations = s.newton_iterations;
-            rec.train.steps = s.steps;
-            rec.train.rejected_steps = s.rejected_steps;
-            rec.train.jacobian_evaluations = s.jacobian_evaluations;
-        }
-        rec.train.wall_time = start.elapsed().as_secs_f64();
+        rec.train.finish(hht.map(|h| h.stats()), start);
         rec
     };
     let mut hht = match Hht::new(sys, 0.0, q0, v0, sc.hht) {

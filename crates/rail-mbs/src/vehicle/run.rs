@@ -153,6 +153,17 @@ pub struct TrainRecord {
 }
 
 impl TrainRecord {
+    /// Copies the integrator's counters (when it was built) and the wall time since `start`.
+    pub(crate) fn finish(&mut self, stats: Option<&crate::integrator::Stats>, start: std::time::Instant) {
+        if let Some(s) = stats {
+            self.newton_iterations = s.newton_iterations;
+            self.steps = s.steps;
+            self.rejected_steps = s.rejected_steps;
+            self.jacobian_evaluations = s.jacobian_evaluations;
+        }
+        self.wall_time = start.elapsed().as_secs_f64();
+    }
+
     /// Column names of [`Self::row`] for a train with `wheelsets` wheelsets, `couplers`
     /// couplers and `cars` cars (the layout of a results stream, `run_train_streamed`).
     pub fn columns(wheelsets: usize, couplers: usize, cars: usize) -> Vec<String> {
@@ -403,14 +414,7 @@ pub fn run_train_streamed(
     let (q0, v0) = mb.initial_coordinates();
     let start = Instant::now();
     let finish = |hht: Option<&Hht<Multibody>>, mut rec: TrainRecord| {
-        if let Some(h) = hht {
-            let s = h.stats();
-            rec.newton_iterations = s.newton_iterations;
-            rec.steps = s.steps;
-            rec.rejected_steps = s.rejected_steps;
-            rec.jacobian_evaluations = s.jacobian_evaluations;
-        }
-        rec.wall_time = start.elapsed().as_secs_f64();
+        rec.finish(hht.map(|h| h.stats()), start);
         rec
     };
     let mut hht = match Hht::new(mb, 0.0, q0, v0, sc.hht) {

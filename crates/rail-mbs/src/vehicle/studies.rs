@@ -75,6 +75,17 @@ impl Oil {
         }
     }
 
+    /// The oil of a name (`light`, `medium`, `heavy`, `water`); anything else is light crude
+    /// (the examples' default).
+    pub fn from_name_or_light(name: &str) -> Self {
+        match name {
+            "medium" => Oil::Medium,
+            "heavy" => Oil::Heavy,
+            "water" => Oil::Water,
+            _ => Oil::Light,
+        }
+    }
+
     /// The fluid with default penalties for a liquid depth and element height.
     pub fn fluid(self, depth: f64, h_el: f64) -> Result<Fluid> {
         let (rho, mu, tau) = self.properties();
