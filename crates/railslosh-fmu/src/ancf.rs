@@ -12,7 +12,7 @@
 use ancf_core::constitutive::Rheology;
 use ancf_core::mesh::{EllipticCylinderSpec, elliptic_cylinder};
 use ancf_core::tank::{TankGeometry, TankShape};
-use rail_mbs::cosim::{ParticipantState, SloshParticipant, SloshParticipantConfig, TankFrameSample, TankMotionInput};
+use rail_mbs::cosim::{ParticipantState, SloshParticipant, SloshParticipantConfig, TankMotionInput};
 
 use crate::model::{FmuModel, ModelConfig, Outputs, TankInput};
 use crate::pendulum::Pendulum;
@@ -25,12 +25,7 @@ pub struct Ancf {
 }
 
 fn sample(u: &TankInput) -> TankMotionInput {
-    TankMotionInput::TankFrame(TankFrameSample {
-        acceleration: u.acceleration,
-        angular_velocity: u.angular_velocity,
-        angular_acceleration: u.angular_acceleration,
-        gravity: u.gravity,
-    })
+    TankMotionInput::TankFrame(*u)
 }
 
 /// Build the ANCF participant of `config` at time `t0`, the fluid at rest in the tank.
@@ -144,7 +139,7 @@ mod tests {
         let mass = m.mass();
         // 2 bricks across the curved section: the mesh volume is within 1 % of the section's
         assert!((mass / (1000.0 * area * c.length) - 1.0).abs() < 0.01, "mass {mass}");
-        let u = TankInput::at_rest();
+        let u = TankInput::at_rest(crate::variables::GRAVITY);
         m.start(&u).unwrap();
         m.advance(0.1, &u, &u).unwrap();
         let saved = m.save_state();

@@ -340,7 +340,7 @@ impl Instance {
     pub fn exit_initialization(&mut self) -> Result<(), String> {
         self.require("fmi3ExitInitializationMode", &[Mode::Initialization])?;
         let u = self.inputs();
-        u.check_finite()?;
+        crate::model::check_finite(&u)?;
         self.ensure_model()?.start(&u)?;
         self.mode = if self.event_mode_used { Mode::Event } else { Mode::Step };
         Ok(())
@@ -385,7 +385,7 @@ impl Instance {
             return Err(format!("step to t = {t_end} passes the stop time {stop}"));
         }
         let u = self.inputs();
-        u.check_finite()?;
+        crate::model::check_finite(&u)?;
         let model = self.ensure_model()?;
         let saved = model.save_state();
         if let Err(e) = model.advance(t_end, &u, &u) {

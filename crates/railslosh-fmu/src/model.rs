@@ -5,58 +5,26 @@
 //! the tank axis, y left, z up, origin at the tank centre); loads are those the fluid exerts
 //! **on the tank**, moments about the reference point `ref_x, ref_y, ref_z`.
 
-/// Tank motion at one instant, tank frame (seed 003's co-simulation interface).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct TankInput {
-    /// Inertial acceleration of the tank origin, without gravity (m/s²).
-    pub acceleration: [f64; 3],
-    /// Angular velocity of the tank (rad/s).
-    pub angular_velocity: [f64; 3],
-    /// Angular acceleration of the tank (rad/s²).
-    pub angular_acceleration: [f64; 3],
-    /// Gravitational acceleration (m/s²); (0, 0, −9.81) for a level tank.
-    pub gravity: [f64; 3],
-}
+/// Tank motion at one instant, tank frame (seed 003's co-simulation interface): the type the
+/// slosh participant takes (`at_rest(g)`, `lerp`).
+pub use rail_mbs::slosh::TankFrameSample as TankInput;
 
-impl TankInput {
-    /// A level tank at rest under standard gravity.
-    pub fn at_rest() -> Self {
-        Self {
-            acceleration: [0.0; 3],
-            angular_velocity: [0.0; 3],
-            angular_acceleration: [0.0; 3],
-            gravity: [0.0, 0.0, -crate::variables::GRAVITY],
-        }
-    }
-
-    /// Linear interpolation `(1 − s) self + s other`.
-    pub fn lerp(&self, other: &Self, s: f64) -> Self {
-        let l = |a: [f64; 3], b: [f64; 3]| std::array::from_fn(|i| a[i] + s * (b[i] - a[i]));
-        Self {
-            acceleration: l(self.acceleration, other.acceleration),
-            angular_velocity: l(self.angular_velocity, other.angular_velocity),
-            angular_acceleration: l(self.angular_acceleration, other.angular_acceleration),
-            gravity: l(self.gravity, other.gravity),
-        }
-    }
-
-    /// The first non-finite component, named as the FMU input variable.
-    pub fn check_finite(&self) -> Result<(), String> {
-        let groups = [
-            ("a", self.acceleration),
-            ("omega", self.angular_velocity),
-            ("omega_dot", self.angular_acceleration),
-            ("gravity", self.gravity),
-        ];
-        for (name, v) in groups {
-            for (c, x) in ["x", "y", "z"].iter().zip(v) {
-                if !x.is_finite() {
-                    return Err(format!("invalid input `{name}_{c}` = {x}: allowed a finite number"));
-                }
+/// The first non-finite component of an input, named as the FMU input variable.
+pub fn check_finite(u: &TankInput) -> Result<(), String> {
+    let groups = [
+        ("a", u.acceleration),
+        ("omega", u.angular_velocity),
+        ("omega_dot", u.angular_acceleration),
+        ("gravity", u.gravity),
+    ];
+    for (name, v) in groups {
+        for (c, x) in ["x", "y", "z"].iter().zip(v) {
+            if !x.is_finite() {
+                return Err(format!("invalid input `{name}_{c}` = {x}: allowed a finite number"));
             }
         }
-        Ok(())
     }
+    Ok(())
 }
 
 /// Fluid loads on the tank and the fluid centre of mass, tank frame.

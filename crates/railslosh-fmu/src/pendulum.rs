@@ -344,7 +344,7 @@ mod tests {
     fn static_loads_are_weight_at_the_centre_of_mass() {
         let c = config(0.4, 0.3, 0.7);
         let p = Pendulum::new(&c, 0.0).unwrap();
-        let out = p.outputs(&TankInput::at_rest());
+        let out = p.outputs(&TankInput::at_rest(crate::variables::GRAVITY));
         let m = p.mass();
         assert!((out.force[2] + m * GRAVITY).abs() < 1e-9 * m);
         assert!(out.force[0].abs() < 1e-9 && out.force[1].abs() < 1e-9);
@@ -361,7 +361,7 @@ mod tests {
         c.damping_ratio = 0.3;
         c.reference = [0.1, -0.2, 0.3];
         let mut p = Pendulum::new(&c, 0.0).unwrap();
-        let mut u = TankInput::at_rest();
+        let mut u = TankInput::at_rest(crate::variables::GRAVITY);
         u.acceleration = [0.5, 2.0, 0.0];
         p.advance(40.0, &u, &u).unwrap();
         let out = p.outputs(&u);
@@ -385,7 +385,7 @@ mod tests {
     fn free_lateral_oscillation_frequency() {
         let c = config(0.6, 0.4, 0.5);
         let mut p = Pendulum::new(&c, 0.0).unwrap();
-        let mut u = TankInput::at_rest();
+        let mut u = TankInput::at_rest(crate::variables::GRAVITY);
         u.gravity = [0.0, 0.0, -6.0];
         u.acceleration = [0.0, 0.3, 0.0];
         p.advance(0.05, &u, &u).unwrap();
@@ -416,7 +416,7 @@ mod tests {
     fn rotation_terms_and_free_bob_tangential_load() {
         let c = config(0.4, 0.4, 0.5);
         let p = Pendulum::new(&c, 0.0).unwrap();
-        let mut u = TankInput::at_rest();
+        let mut u = TankInput::at_rest(crate::variables::GRAVITY);
         u.angular_velocity = [0.3, -0.4, 0.2];
         u.angular_acceleration = [0.5, 0.2, 0.7];
         let out = p.outputs(&u);
@@ -440,7 +440,7 @@ mod tests {
     fn save_restore_round_trip() {
         let c = config(0.4, 0.3, 0.6);
         let mut p = Pendulum::new(&c, 0.0).unwrap();
-        let mut u = TankInput::at_rest();
+        let mut u = TankInput::at_rest(crate::variables::GRAVITY);
         u.acceleration = [0.2, 1.0, 0.0];
         p.advance(0.3, &u, &u).unwrap();
         let s = p.save_state();
