@@ -5,7 +5,7 @@ use rail_mbs::vehicle::studies::{Oil, curve_run};
 
 fn main() {
     let a: Vec<String> = std::env::args().skip(1).collect();
-    let oil = Oil::from_name_or_light(a.first().map_or("light", |s| s.as_str()));
+    let oil = Oil::from_name(a.first().map_or("light", |s| s.as_str())).unwrap_or(Oil::Light);
     let arg = |i: usize, d: f64| a.get(i).map_or(d, |s| s.parse().expect("a number"));
     let kmh = arg(1, 100.0);
     let counts = [arg(2, 6.0) as usize, arg(3, 4.0) as usize, arg(4, 2.0) as usize];

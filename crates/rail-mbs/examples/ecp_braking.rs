@@ -5,7 +5,7 @@ use rail_mbs::vehicle::studies::{BrakingCase, Oil, SETTLE, run_braking};
 
 fn main() {
     let a: Vec<String> = std::env::args().skip(1).collect();
-    let oil = Oil::from_name_or_light(a.first().map_or("light", |s| s.as_str()));
+    let oil = Oil::from_name(a.first().map_or("light", |s| s.as_str())).unwrap_or(Oil::Light);
     let n = |i: usize, d: usize| a.get(i).map_or(d, |s| s.parse().unwrap());
     let counts = [n(1, 6), n(2, 4), n(3, 2)];
     let t_end: f64 = a.get(4).map_or(SETTLE + 10.0, |s| s.parse().unwrap());

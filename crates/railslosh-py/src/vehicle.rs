@@ -12,9 +12,10 @@ use rail_mbs::profile::aar1b_wheel_approx;
 use rail_mbs::track::{Track, TrackPoint};
 use rail_mbs::vehicle::studies::{Oil, brake_torque};
 use rail_mbs::vehicle::{
-    BrakeScope, EquivalentCargo, EquivalentModel, EquivalentTrainRecord, FluidCargo, FluidTrainRecord, SloshAxis,
-    TankCarParams, TrainRecord, TrainScenario, run_equivalent_train_streamed as rust_run_equivalent_train,
-    run_fluid_train_streamed as rust_run_fluid_train, run_train_streamed as rust_run_train,
+    BrakeScope, EquivalentCargo, EquivalentModel, EquivalentTrainRecord, FluidCargo, FluidTrainRecord, Observer,
+    SampleSink, SloshAxis, TankCarParams, TrainRecord, TrainScenario,
+    run_equivalent_train_streamed as rust_run_equivalent_train, run_fluid_train_streamed as rust_run_fluid_train,
+    run_train_streamed as rust_run_train,
 };
 
 use crate::{PyProgress, compute};
@@ -221,23 +222,41 @@ pub fn run_train<'py>(
     sc.brake = brake;
     sc.wheelset_lateral_offset = wheelset_lateral_offset;
     sc.coupler = (coupler_stiffness, coupler_damping);
+    let columns = rail_mbs::vehicle::TrainRecord::columns(4 * sc.cars, sc.cars.saturating_sub(1), sc.cars);
+    let run = move |obs: Observer<'_>, sink: SampleSink<'_>| {
+        Ok(match rust_run_train(&sc, obs, Some(sink))? {
+            Ok(r) => (r, None),
+            Err(f) => (f.record, Some(f.error.to_string())),
+        })
+    };
+    run_recorded(py, progress, stream, columns, run, |py, r| record_dict(py, r))
+}
+
+/// Runs a train with the GIL released, `progress` called as it goes and every recorded
+/// sample appended to the `stream` file (layout `columns`); returns the record as a dict
+/// (`to_dict`), with an `error` entry when the run stopped early. `run` gets the observer and
+/// the sink and returns the record, and the error if it failed.
+fn run_recorded<'py, R: Send>(
+    py: Python<'py>,
+    progress: Option<Py<PyAny>>,
+    stream: Option<std::path::PathBuf>,
+    columns: Vec<String>,
+    run: impl FnOnce(Observer<'_>, SampleSink<'_>) -> Result<(R, Option<String>), AncfError> + Send,
+    to_dict: impl Fn(Python<'py>, &R) -> PyResult<Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyDict>> {
     let mut observer = PyProgress::new(progress);
     let obs = &mut observer;
-    let columns = rail_mbs::vehicle::TrainRecord::columns(4 * sc.cars, sc.cars.saturating_sub(1), sc.cars);
-    let out = compute(py, move || {
+    let (record, error) = compute(py, move || {
         let mut journal = open_stream(stream.as_deref(), &columns)?;
         let mut sink = |row: &[f64]| journal.as_mut().map_or(Ok(()), |j| j.append(row));
-        rust_run_train(&sc, &mut |p| obs.observe(p), Some(&mut sink))
+        run(&mut |p| obs.observe(p), &mut sink)
     })?;
     observer.finish()?;
-    match out {
-        Ok(r) => record_dict(py, &r),
-        Err(f) => {
-            let d = record_dict(py, &f.record)?;
-            d.set_item("error", f.error.to_string())?;
-            Ok(d)
-        }
+    let d = to_dict(py, &record)?;
+    if let Some(e) = error {
+        d.set_item("error", e)?;
     }
+    Ok(d)
 }
 
 /// The results stream of a run (`stream=` path): every recorded sample is appended and
@@ -254,13 +273,7 @@ fn open_stream(
 }
 
 fn oil_of(name: &str) -> PyResult<Oil> {
-    Ok(match name {
-        "light" => Oil::Light,
-        "medium" => Oil::Medium,
-        "heavy" => Oil::Heavy,
-        "water" => Oil::Water,
-        other => return Err(crate::to_py(invalid("oil", other, "'light', 'medium', 'heavy' or 'water'"))),
-    })
+    Oil::from_name(name).map_err(crate::to_py)
 }
 
 fn fluid_record_dict<'py>(py: Python<'py>, r: &FluidTrainRecord) -> PyResult<Bound<'py, PyDict>> {
@@ -359,23 +372,14 @@ pub fn run_fluid_train<'py>(
     sc.brake = brake;
     sc.brake_factors = brake_factors.unwrap_or_default();
     sc.hht.refresh_rate = 0.5;
-    let mut observer = PyProgress::new(progress);
-    let obs = &mut observer;
     let columns = rail_mbs::vehicle::FluidTrainRecord::columns(4 * sc.cars, sc.cars.saturating_sub(1), sc.cars);
-    let out = compute(py, move || {
-        let mut journal = open_stream(stream.as_deref(), &columns)?;
-        let mut sink = |row: &[f64]| journal.as_mut().map_or(Ok(()), |j| j.append(row));
-        rust_run_fluid_train(&sc, &cargo, &mut |p| obs.observe(p), Some(&mut sink))
-    })?;
-    observer.finish()?;
-    match out {
-        Ok(r) => fluid_record_dict(py, &r),
-        Err(f) => {
-            let d = fluid_record_dict(py, &f.record)?;
-            d.set_item("error", f.error.to_string())?;
-            Ok(d)
-        }
-    }
+    let run = move |obs: Observer<'_>, sink: SampleSink<'_>| {
+        Ok(match rust_run_fluid_train(&sc, &cargo, obs, Some(sink))? {
+            Ok(r) => (r, None),
+            Err(f) => (f.record, Some(f.error.to_string())),
+        })
+    };
+    run_recorded(py, progress, stream, columns, run, |py, r| fluid_record_dict(py, r))
 }
 
 fn slosh_axis_of(name: &str) -> PyResult<SloshAxis> {
@@ -534,23 +538,14 @@ pub fn run_equivalent_train<'py>(
     sc.drive = drive_speed.map(SpeedProfile::Constant);
     sc.brake = brake;
     sc.brake_factors = brake_factors.unwrap_or_default();
-    let mut observer = PyProgress::new(progress);
-    let obs = &mut observer;
     let columns = EquivalentTrainRecord::columns(4 * sc.cars, sc.cars.saturating_sub(1), sc.cars, modes);
-    let out = compute(py, move || {
-        let mut journal = open_stream(stream.as_deref(), &columns)?;
-        let mut sink = |row: &[f64]| journal.as_mut().map_or(Ok(()), |j| j.append(row));
-        rust_run_equivalent_train(&sc, &cargo, &mut |p| obs.observe(p), Some(&mut sink))
-    })?;
-    observer.finish()?;
-    match out {
-        Ok(r) => equivalent_record_dict(py, &r),
-        Err(f) => {
-            let d = equivalent_record_dict(py, &f.record)?;
-            d.set_item("error", f.error.to_string())?;
-            Ok(d)
-        }
-    }
+    let run = move |obs: Observer<'_>, sink: SampleSink<'_>| {
+        Ok(match rust_run_equivalent_train(&sc, &cargo, obs, Some(sink))? {
+            Ok(r) => (r, None),
+            Err(f) => (f.record, Some(f.error.to_string())),
+        })
+    };
+    run_recorded(py, progress, stream, columns, run, |py, r| equivalent_record_dict(py, r))
 }
 
 /// Registers the vehicle functions.

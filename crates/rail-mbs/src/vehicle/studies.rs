@@ -75,14 +75,14 @@ impl Oil {
         }
     }
 
-    /// The oil of a name (`light`, `medium`, `heavy`, `water`); anything else is light crude
-    /// (the examples' default).
-    pub fn from_name_or_light(name: &str) -> Self {
+    /// The oil of a name: `light`, `medium`, `heavy` or `water`.
+    pub fn from_name(name: &str) -> Result<Self> {
         match name {
-            "medium" => Oil::Medium,
-            "heavy" => Oil::Heavy,
-            "water" => Oil::Water,
-            _ => Oil::Light,
+            "light" => Ok(Oil::Light),
+            "medium" => Ok(Oil::Medium),
+            "heavy" => Ok(Oil::Heavy),
+            "water" => Ok(Oil::Water),
+            other => Err(invalid("oil", other, "'light', 'medium', 'heavy' or 'water'")),
         }
     }
 
