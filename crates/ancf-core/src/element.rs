@@ -309,6 +309,12 @@ impl ElementRef {
             for (p, (rp, dn)) in pts.iter().zip(&table.dn).enumerate() {
                 let f = grad_xi(&ehat, dn) * rp.jinv;
                 let fd = grad_xi(&edhat, dn) * rp.jinv;
+                // B_a = Ĵ₀⁻ᵀ ∂n_a/∂ξ (so ∂F_iJ/∂ê_{a,i} = B_a,J)
+                let mut bmat = [[0.0; 3]; N_SHAPE];
+                for a in 0..N_SHAPE {
+                    let v = rp.jinv.transpose() * Vector3::new(dn[a][0], dn[a][1], dn[a][2]);
+                    bmat[a] = [v[0], v[1], v[2]];
+                }
                 let pk = if deviatoric {
                     let t = if want_t { Some((&mut tf, &mut tv)) } else { None };
                     fluid.deviatoric_stress(&f, &fd, t).ok_or(AncfError::InvertedElement {
@@ -317,19 +323,11 @@ impl ElementRef {
                         j: f.determinant(),
                     })?
                 } else if let Some(vol) = vol.as_mut() {
-                    let pk = fluid.volumetric_stress(&f, &fd, None).0;
-                    vol.push(fluid, rp, dn, &f, &fd, &self.scale);
-                    pk
+                    vol.push(fluid, rp.wdet, &bmat, &f, &fd, &self.scale)
                 } else {
                     let t = if want_t { Some((&mut tf, &mut tv)) } else { None };
                     fluid.volumetric_stress(&f, &fd, t).0
                 };
-                // B_a = Ĵ₀⁻ᵀ ∂n_a/∂ξ (so ∂F_iJ/∂ê_{a,i} = B_a,J)
-                let mut bmat = [[0.0; 3]; N_SHAPE];
-                for a in 0..N_SHAPE {
-                    let v = rp.jinv.transpose() * Vector3::new(dn[a][0], dn[a][1], dn[a][2]);
-                    bmat[a] = [v[0], v[1], v[2]];
-                }
                 let ph = rp.wdet * pk;
                 for a in 0..N_SHAPE {
                     let sa = self.scale[a];
@@ -450,21 +448,24 @@ impl VolumetricTangents {
         }
     }
 
+    /// Adds a penalty point (weight `w`, shape gradients `bmat` = B_a) and returns its stress
+    /// P = p cof F, computed as [`Fluid::volumetric_stress`] does (the same operations, so the
+    /// forces of both Jacobian paths are identical).
     fn push(
         &mut self,
         fluid: &Fluid,
-        rp: &RefPoint,
-        dn: &[[f64; 3]; N_SHAPE],
+        w: f64,
+        bmat: &[[f64; 3]; N_SHAPE],
         f: &M3,
         fd: &M3,
         scale: &[f64; N_SHAPE],
-    ) {
+    ) -> M3 {
         let (k, c) = (fluid.bulk_penalty, fluid.bulk_damping);
         let cof = cofactor(f);
         let g = cofactor_derivative(f, fd); // ∂J̇/∂F
         let j = f.determinant();
         let p = k * (j - 1.0) + c * cof.component_mul(fd).sum();
-        let (w, n) = (rp.wdet, self.n);
+        let n = self.n;
         // [−f_l]ₓ: (B × f_l) = −[f_l]ₓ B
         let cross = |l: usize| -> M3 {
             let (x, y, z) = (f[(l, 0)], f[(l, 1)], f[(l, 2)]);
@@ -472,7 +473,7 @@ impl VolumetricTangents {
         };
         let a_l = [cross(0) * (w * p), cross(1) * (w * p), cross(2) * (w * p)];
         for a in 0..N_SHAPE {
-            let bv = rp.jinv.transpose() * Vector3::new(dn[a][0], dn[a][1], dn[a][2]) * scale[a];
+            let bv = Vector3::from(bmat[a]) * scale[a];
             let vb = cof * bv; // (Σ_J cof_iJ B_aJ)_i
             let ub = g * bv;
             for i in 0..3 {
@@ -489,6 +490,7 @@ impl VolumetricTangents {
             }
         }
         self.n += 1;
+        p * cof
     }
 
     fn assemble(&self, k: &mut [f64], c: &mut [f64]) {
