@@ -409,3 +409,18 @@ fn adaptive_steps_stretch_to_the_requested_step_instead_of_leaving_a_sliver() {
     assert_eq!(info.h, 4e-3 + 0.5 * h_min);
     assert!((hht.t() - (t1 + 4e-3 + 0.5 * h_min)).abs() < 1e-15);
 }
+
+#[test]
+fn constraint_unknowns_are_described_by_joint_equation() {
+    use rail_mbs::integrator::KktIndex;
+    let (mb, _, _) = pendulum();
+    // one normalization row, then the revolute joint's five equations
+    assert_eq!(
+        mb.describe_unknown(KktIndex::Constraint(0)),
+        "constraint 0 = Euler-parameter normalization of body 'rod'"
+    );
+    assert_eq!(mb.describe_unknown(KktIndex::Constraint(1)), "constraint 1 = equation 0 of joint 'pin'");
+    assert_eq!(mb.describe_unknown(KktIndex::Constraint(5)), "constraint 5 = equation 4 of joint 'pin'");
+    assert_eq!(mb.describe_unknown(KktIndex::Constraint(6)), "constraint 6");
+    assert_eq!(mb.describe_unknown(KktIndex::Coordinate(2)), "coordinate 2 = z of body 'rod'");
+}

@@ -228,3 +228,24 @@ fn declared_mass_entries_cover_the_mass_matrix() {
     let dev = a.q().iter().zip(b.q()).fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
     assert!(dev < 1e-12, "declared vs undeclared mass entries: max |dq| = {dev:e}");
 }
+
+#[test]
+fn unknowns_are_described_by_body_and_fluid_node() {
+    // Newton-divergence messages name the unknown with the largest correction through
+    // `describe_unknown`: rigid coordinates by body, fluid coordinates by node and slot.
+    use rail_mbs::integrator::KktIndex;
+    let sys = system(true);
+    assert_eq!(sys.describe_unknown(KktIndex::Coordinate(1)), "coordinate 1 = y of body 'tank'");
+    assert_eq!(sys.describe_unknown(KktIndex::Coordinate(5)), "coordinate 5 = e2 of body 'tank'");
+    // node 2, slot 1 (∂r/∂X), z: 7 rigid + 12·2 + 3 + 2
+    assert_eq!(
+        sys.describe_unknown(KktIndex::Coordinate(36)),
+        "coordinate 36 = gradient d/dX z of node 2 of fluid 0 (tank 'tank')"
+    );
+    assert_eq!(
+        sys.describe_unknown(KktIndex::Constraint(0)),
+        "constraint 0 = Euler-parameter normalization of body 'tank'"
+    );
+    let n = sys.n_coords();
+    assert_eq!(sys.describe_unknown(KktIndex::Coordinate(n)), format!("coordinate {n}"));
+}

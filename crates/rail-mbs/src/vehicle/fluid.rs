@@ -229,17 +229,13 @@ impl MechanicalSystem for FluidVehicle {
             return self.mb.describe_unknown(index);
         }
         const SLOTS: [&str; 4] = ["position", "gradient d/dX", "gradient d/dY", "gradient d/dZ"];
-        let mut offset = self.n_rigid;
-        for (k, f) in self.fluids.iter().enumerate() {
-            let n = f.body.n_coords();
-            if i < offset + n {
-                let local = i - offset;
+        for (k, (f, lay)) in self.fluids.iter().zip(&self.layouts).enumerate() {
+            if (lay.offset..lay.offset + f.body.n_coords()).contains(&i) {
+                let local = i - lay.offset;
                 let (node, slot, c) = (local / 12, (local % 12) / 3, ["x", "y", "z"][local % 3]);
-                return format!("coordinate {i} = {} {c} of node {node} of fluid {k} (tank '{}')", SLOTS[slot], {
-                    self.mb.bodies()[f.tank.0].name.as_str()
-                });
+                let tank = &self.mb.bodies()[f.tank.0].name;
+                return format!("coordinate {i} = {} {c} of node {node} of fluid {k} (tank '{tank}')", SLOTS[slot]);
             }
-            offset += n;
         }
         index.to_string()
     }
