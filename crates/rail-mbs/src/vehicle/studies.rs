@@ -35,11 +35,12 @@ use ancf_core::element::QuadratureOptions;
 use ancf_core::error::{AncfError, Result, invalid};
 use ancf_core::validate::Record;
 
+use super::equivalent::cylinder_lambda;
 use super::fluid::{FluidCargo, FluidTrainRecord, run_fluid_train};
 use super::run::{BrakeScope, TrainScenario};
 use super::tank_car::TankCarParams;
 use crate::mbs::{SpeedProfile, Table};
-use crate::track::{GRAVITY, Track, TrackPoint};
+use crate::track::{FOOT, GRAVITY, Track, TrackPoint};
 
 /// The liquids of the studies.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -417,30 +418,28 @@ fn bulkhead_reduction(quick: bool) -> Result<Vec<Record>> {
     ])
 }
 
+/// Seed 000 Table 1 track: (distance ft, curvature degrees, super-elevation in).
+const TABLE1_ROWS: [(f64, f64, f64); 10] = [
+    (0.0, 0.0, 0.0),
+    (100.0, 0.0, 0.0),
+    (300.0, 3.0, 3.0),
+    (600.0, 3.0, 3.0),
+    (800.0, 0.0, 0.0),
+    (1000.0, 0.0, 0.0),
+    (1200.0, -3.0, -3.0),
+    (1500.0, -3.0, -3.0),
+    (1700.0, 0.0, 0.0),
+    (2800.0, 0.0, 0.0),
+];
+
 /// Seed 000 Table 1 track (US units).
 pub fn table1() -> Result<Arc<Track>> {
-    let rows: [(f64, f64, f64); 10] = [
-        (0.0, 0.0, 0.0),
-        (100.0, 0.0, 0.0),
-        (300.0, 3.0, 3.0),
-        (600.0, 3.0, 3.0),
-        (800.0, 0.0, 0.0),
-        (1000.0, 0.0, 0.0),
-        (1200.0, -3.0, -3.0),
-        (1500.0, -3.0, -3.0),
-        (1700.0, 0.0, 0.0),
-        (2800.0, 0.0, 0.0),
-    ];
-    let pts = rows.iter().map(|&(d, c, e)| TrackPoint::from_us(d, c, e, 0.0, 0.025, -0.025)).collect();
+    let pts = TABLE1_ROWS.iter().map(|&(d, c, e)| TrackPoint::from_us(d, c, e, 0.0, 0.025, -0.025)).collect();
     Track::new(pts).map(Arc::new).map_err(|e| invalid("track", e, "valid"))
 }
 
-/// First transverse sloshing eigenvalue ω²R/g of a half-full horizontal circular cylinder
-/// (Budiansky 1960; McIver 1989; checked by the Steklov solve of `railslosh.cosim`).
-pub const LAMBDA_HALF_FULL: f64 = 1.3557;
-
-/// End of the body (constant curvature) of the Table 1 curve: 600 ft, m.
-pub const TABLE1_BODY_END: f64 = 600.0 * 0.3048;
+/// End of the body (constant curvature) of the first Table 1 curve, m.
+pub const TABLE1_BODY_END: f64 = TABLE1_ROWS[3].0 * FOOT;
 
 /// Outward inertia force and in-plane gravity component of the oil (mean over the last
 /// period of the first transverse slosh mode) for one car driven at `speed` through the Table 1 curve. The run starts with the
@@ -473,10 +472,10 @@ pub fn curve_run(oil: Oil, speed: f64, counts: [usize; 3], t_end: f64) -> Result
     // CoM acceleration by central differences of the recorded global CoM.
     let (t, x) = (&rec.train.t, &rec.oil_com_global);
     // Averaging window: one period of the first transverse slosh mode of the half-full
-    // cylinder (λ = ω²R/g = 1.3557, notes §1b; 2.1 s for R = 1.5 m), so that the sloshing
+    // cylinder (λ = ω²R/g = 1.3557, `equivalent::cylinder_lambda`; 2.1 s for R = 1.5 m), so that the sloshing
     // started by placing the car in the curve with a flat free surface averages out (the
     // light crude barely damps it), but no longer than the run minus 0.3 s.
-    let period = 2.0 * std::f64::consts::PI / (LAMBDA_HALF_FULL * GRAVITY / radius).sqrt();
+    let period = 2.0 * std::f64::consts::PI / (cylinder_lambda(0.5)? * GRAVITY / radius).sqrt();
     let window = period.min(t_end - 0.3);
     let (mut fc, mut gc, mut n) = (0.0, 0.0, 0);
     for k in 1..t.len() - 1 {
