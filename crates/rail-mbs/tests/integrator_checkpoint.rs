@@ -424,3 +424,19 @@ fn constraint_unknowns_are_described_by_joint_equation() {
     assert_eq!(mb.describe_unknown(KktIndex::Constraint(6)), "constraint 6");
     assert_eq!(mb.describe_unknown(KktIndex::Coordinate(2)), "coordinate 2 = z of body 'rod'");
 }
+
+#[test]
+fn a_newton_divergence_names_the_unknown_with_the_largest_correction() {
+    // A fixed step far too long for one Newton iteration to converge: the error names the
+    // unknown through the system's description (here the swinging rod's coordinates).
+    let (mb, q0, v0) = pendulum();
+    let params =
+        HhtParams { step_control: StepControl::Fixed, max_iterations: 1, rel_tol: 1e-12, ..HhtParams::default() };
+    let mut hht = Hht::new(mb, 0.0, q0, v0, params).unwrap();
+    let err = hht.step(0.2).unwrap_err();
+    let IntegratorError::NewtonDivergence { largest: Some(w), .. } = &err else {
+        panic!("expected a Newton divergence naming an unknown: {err}");
+    };
+    assert!(w.contains("of body 'rod'") || w.contains("of joint 'pin'"), "{w}");
+    assert!(err.to_string().contains(&format!("largest correction: {w}")), "{err}");
+}

@@ -544,15 +544,15 @@ impl<S: MechanicalSystem> Hht<S> {
                         mode = RefreshMode::EveryIteration;
                         continue;
                     }
-                    let largest = if cause.is_none() && iterations > 0 { self.largest_correction() } else { None };
+                    // Only when the run stops: the description scans the correction.
                     let give_up = |h: f64| {
-                        cause.clone().unwrap_or(IntegratorError::NewtonDivergence {
+                        cause.clone().unwrap_or_else(|| IntegratorError::NewtonDivergence {
                             t: self.t,
                             h,
                             iterations,
                             correction,
                             rate,
-                            largest: largest.clone(),
+                            largest: if iterations > 0 { self.largest_correction() } else { None },
                         })
                     };
                     let Some(p) = adaptive else {
