@@ -196,7 +196,6 @@ def _cmd_run(args: argparse.Namespace) -> int:
     out = Path(args.out) if args.out else Path("out") / Path(args.scene).stem
     out.mkdir(parents=True, exist_ok=True)
     print(f"railslosh run: {sc.name or Path(args.scene).stem} ({sc.kind}, t_end = {sc.t_end:g} s) -> {out}")
-    choice = None
     if sc.kind != "slosh":
         from railslosh import fluid_model
 
@@ -236,8 +235,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
         "stats": dict(st),
         "error": res.get("error"),
     }
-    if choice is not None:
-        summary |= {"fluid_model": choice.model, "fluid_model_reason": choice.reason}
+    # the model the run used (run_scene records it, also on a failed run)
+    summary |= {k: res[k] for k in ("fluid_model", "fluid_model_reason") if k in res}
     (out / "run.json").write_text(json.dumps(summary, indent=1, default=str), encoding="utf-8")
     print(
         f"  {st.get('steps', 0)} steps, {st.get('newton_iterations', 0)} Newton iterations, "
