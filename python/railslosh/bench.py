@@ -9,10 +9,13 @@ every point its wall time and its errors against a converged reference run:
   centre-of-mass history.
 - ``ecp-braking``: the two-car ECP braking study of seed 000 (light crude); errors of the peak
   coupler force and of the front car's longitudinal oil centre-of-mass history.
+- ``ecp-braking-spread``: the same with the rear car's brake force 10 % lower, the
+  configuration whose coupler force is first order (with identical cars the ECP coupler force
+  is a second-order pitch effect, see ``docs/validation.md``).
 
 :func:`write` saves the points as ``work_precision.csv`` and ``work_precision.json`` and plots
 error against wall time (``work_precision_<case>.png``). Quick forms take seconds (CI); the
-full ``ecp-braking`` sweep takes about an hour on one core.
+full ``ecp-braking`` sweeps take one to two hours on one core.
 """
 
 from __future__ import annotations

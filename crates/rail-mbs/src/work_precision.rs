@@ -8,6 +8,7 @@
 //! |---|---|
 //! | `slosh-tank` | first-mode frequency vs the analytic 1.436 Hz and vs the reference run; lateral centre-of-mass history (max deviation / reference amplitude) |
 //! | `ecp-braking` | peak coupler force; longitudinal oil centre-of-mass history of the front car (max deviation / reference amplitude) |
+//! | `ecp-braking-spread` | the same, with the rear car's brake force 10 % lower (the configuration whose coupler force is first order, `docs/validation.md`) |
 //!
 //! The reference is the finest setting of the sweep, run with the same code. Points that
 //! fail (Newton divergence, inverted element) are kept with their error message: a setting
@@ -33,7 +34,11 @@ use crate::vehicle::studies::{BrakingCase, Oil, SETTLE, run_braking_with};
 const G: f64 = 9.81;
 
 /// Names of the sweeps.
-pub const CASES: [&str; 2] = ["slosh-tank", "ecp-braking"];
+pub const CASES: [&str; 3] = ["slosh-tank", "ecp-braking", "ecp-braking-spread"];
+
+/// Rear-car brake factor of the `ecp-braking-spread` sweep (the −10 % spread of the
+/// `ecp-braking-oils` validation case).
+pub const SPREAD_REAR_BRAKE_FACTOR: f64 = 0.9;
 
 /// One point of a sweep: its settings, cost and errors.
 #[derive(Debug, Clone, PartialEq)]
@@ -84,9 +89,20 @@ fn interp(t: &[f64], x: &[f64], tq: f64) -> f64 {
 /// Runs a sweep. `quick`: a small grid for CI (seconds); the full grids take minutes
 /// (`slosh-tank`) to about an hour (`ecp-braking`).
 pub fn run_case(name: &str, quick: bool) -> Result<Vec<WorkPoint>> {
+    run_case_with(name, quick, &mut |_| {})
+}
+
+/// [`run_case`], calling `progress` with each point as soon as it is measured (the
+/// reference first), so that a long sweep reports as it goes.
+pub fn run_case_with(name: &str, quick: bool, progress: &mut dyn FnMut(&WorkPoint)) -> Result<Vec<WorkPoint>> {
     match name {
-        "slosh-tank" => slosh_tank(quick),
-        "ecp-braking" => ecp_braking(quick),
+        "slosh-tank" => {
+            let points = slosh_tank(quick)?;
+            points.iter().for_each(&mut *progress);
+            Ok(points)
+        }
+        "ecp-braking" => ecp_braking(quick, 1.0, name, progress),
+        "ecp-braking-spread" => ecp_braking(quick, SPREAD_REAR_BRAKE_FACTOR, name, progress),
         _ => Err(AncfError::InvalidParameter {
             field: "case".into(),
             value: name.into(),
@@ -195,6 +211,7 @@ fn slosh_tank(quick: bool) -> Result<Vec<WorkPoint>> {
                 ("penalty_points".into(), s.penalty_points as f64),
                 ("iterative".into(), if s.iterative { 1.0 } else { 0.0 }),
                 ("t_end_s".into(), t_end),
+                ("rear_brake_factor".into(), rear_brake_factor),
             ],
             wall_s: out.wall,
             steps: out.stats.steps,
@@ -225,7 +242,12 @@ struct EcpSetting {
     rel_tol: f64,
 }
 
-fn ecp_braking(quick: bool) -> Result<Vec<WorkPoint>> {
+fn ecp_braking(
+    quick: bool,
+    rear_brake_factor: f64,
+    name: &str,
+    progress: &mut dyn FnMut(&WorkPoint),
+) -> Result<Vec<WorkPoint>> {
     // quick: 2 s after settling on 12-element tanks; full: the paper's 10 s on 48 elements
     let (t_end, reference, grid) = if quick {
         let r = EcpSetting { counts: [3, 2, 2], step: 1e-3, rel_tol: 1e-6 };
@@ -253,7 +275,7 @@ fn ecp_braking(quick: bool) -> Result<Vec<WorkPoint>> {
             bulkheads: false,
             counts: s.counts,
             t_end,
-            rear_brake_factor: 1.0,
+            rear_brake_factor,
         };
         let tic = Instant::now();
         let out = run_braking_with(&case, s.step, s.rel_tol);
@@ -297,13 +319,14 @@ fn ecp_braking(quick: bool) -> Result<Vec<WorkPoint>> {
             ),
         };
         points.push(WorkPoint {
-            case: "ecp-braking".into(),
+            case: name.into(),
             reference: k == 0,
             settings: vec![
                 ("h_max_s".into(), s.step),
                 ("rel_tol".into(), s.rel_tol),
                 ("elements_per_tank".into(), (s.counts[0] * s.counts[1] * s.counts[2]) as f64),
                 ("t_end_s".into(), t_end),
+                ("rear_brake_factor".into(), rear_brake_factor),
             ],
             wall_s: wall,
             steps,
@@ -316,6 +339,7 @@ fn ecp_braking(quick: bool) -> Result<Vec<WorkPoint>> {
             errors,
             failure,
         });
+        progress(points.last().expect("just pushed"));
     }
     Ok(points)
 }
