@@ -211,7 +211,6 @@ fn slosh_tank(quick: bool) -> Result<Vec<WorkPoint>> {
                 ("penalty_points".into(), s.penalty_points as f64),
                 ("iterative".into(), if s.iterative { 1.0 } else { 0.0 }),
                 ("t_end_s".into(), t_end),
-                ("rear_brake_factor".into(), rear_brake_factor),
             ],
             wall_s: out.wall,
             steps: out.stats.steps,
