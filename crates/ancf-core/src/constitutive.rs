@@ -49,6 +49,15 @@
 //! element's stress-free reference, so a fluid that has flowed far is always in the
 //! yielded (Bingham) branch. τ₀ = 0 gives the Newtonian fluid exactly.
 //!
+//! # Newtonian fast path
+//! When 2η(s) is a constant and there is no elastic branch ([`Fluid::newtonian_two_eta`]:
+//! Newtonian, and Bingham, Oldroyd, Casson with τ₀ = 0, Herschel–Bulkley with τ₀ = 0 and
+//! n = 1), s and the regularization play no role and [`Fluid::deviatoric_stress`] takes the
+//! closed-form kernel [`newtonian_stress`]: the same stress (bit-identical) and tangents
+//! written entry by entry (equal to round-off, about 8× cheaper per point than the
+//! generic directional derivatives; `benches/element.rs`). [`DeviatoricPath::Generic`]
+//! forces the generic kernel for comparison.
+//!
 //! # Penalty incompressibility (seed 000 §4.1)
 //! U_IC = ∫ ½ k_IC (J − 1)² dV₀ and the dissipation ∫ ½ c_TD J̇² dV₀ give
 //! P_pen = [k_IC (J − 1) + c_TD J̇] ∂J/∂F, with ∂J/∂F = cof F = [f₂×f₃, f₃×f₁, f₁×f₂]
@@ -154,6 +163,40 @@ impl Rheology {
         }
     }
 
+    /// The constant 2η when this law is effectively Newtonian, i.e. when [`Rheology::two_eta`]
+    /// returns the same value and a zero derivative for every s > 0; `None` otherwise.
+    ///
+    /// Per law (read off `two_eta`): Newtonian always (2μ); Bingham, Oldroyd and Casson
+    /// when τ₀ = 0 (the τ₀/s and √(τ₀μ/s) terms vanish, 2μ remains); Herschel–Bulkley when
+    /// τ₀ = 0 and either n = 1 ((2s)⁰ = 1, so 2K) or K = 0 (2η ≡ 0). Any τ₀ > 0, or a
+    /// power-law index n ≠ 1 with K > 0, makes 2η depend on s: not Newtonian. The
+    /// regularization γ̇_ε only enters through s, so it plays no role in the constant cases.
+    /// (The Oldroyd elastic branch exists only for τ₀ > 0, so it is excluded too; see
+    /// [`Fluid::newtonian_two_eta`].)
+    pub fn constant_two_eta(&self) -> Option<f64> {
+        match *self {
+            Rheology::Newtonian { viscosity } => Some(2.0 * viscosity),
+            Rheology::Bingham { viscosity, yield_stress }
+            | Rheology::Casson { viscosity, yield_stress }
+            | Rheology::Oldroyd { viscosity, yield_stress, .. }
+                if yield_stress == 0.0 =>
+            {
+                Some(2.0 * viscosity)
+            }
+            Rheology::HerschelBulkley { consistency, power_index, yield_stress }
+                if yield_stress == 0.0 && (power_index == 1.0 || consistency == 0.0) =>
+            {
+                Some(2.0 * consistency)
+            }
+            _ => None,
+        }
+    }
+
+    /// True when the law is effectively Newtonian (see [`Rheology::constant_two_eta`]).
+    pub fn is_effectively_newtonian(&self) -> bool {
+        self.constant_two_eta().is_some()
+    }
+
     /// 2η(s) and its derivative with respect to s = ‖D‖ (regularized), for the viscous
     /// (yielded) branch.
     #[inline]
@@ -239,9 +282,54 @@ impl Fluid {
         matches!(self.rheology, Rheology::Oldroyd { yield_stress, .. } if yield_stress > 0.0)
     }
 
+    /// The constant 2η when the deviatoric stress of this fluid is exactly Newtonian,
+    /// P = 2η J D F⁻ᵀ with 2η independent of s and no elastic branch: the law is effectively
+    /// Newtonian ([`Rheology::constant_two_eta`]) and [`Fluid::has_elastic_branch`] is false.
+    pub fn newtonian_two_eta(&self) -> Option<f64> {
+        if self.has_elastic_branch() { None } else { self.rheology.constant_two_eta() }
+    }
+
+    /// True when [`Fluid::deviatoric_stress`] takes the closed-form Newtonian kernel
+    /// ([`newtonian_stress`]).
+    pub fn is_effectively_newtonian(&self) -> bool {
+        self.newtonian_two_eta().is_some()
+    }
+
     /// Deviatoric (viscous / Oldroyd) first Piola stress at a point, with optional
     /// tangents. Returns `None` if F is not invertible with positive determinant.
+    ///
+    /// An effectively Newtonian fluid ([`Fluid::newtonian_two_eta`]) takes the closed-form
+    /// kernel [`newtonian_stress`]; every other fluid the generic one (9 directional
+    /// derivatives). Both give the same stress and tangents to round-off
+    /// (`tests/newtonian_fast_path.rs`).
+    #[inline]
     pub fn deviatoric_stress(&self, f: &M3, fdot: &M3, tangents: Option<(&mut Tangent, &mut Tangent)>) -> Option<M3> {
+        self.deviatoric_stress_with(f, fdot, tangents, DeviatoricPath::Auto)
+    }
+
+    /// [`Fluid::deviatoric_stress`] through the chosen kernel: the two kernels are tested and
+    /// benchmarked against each other.
+    #[inline]
+    pub fn deviatoric_stress_with(
+        &self,
+        f: &M3,
+        fdot: &M3,
+        tangents: Option<(&mut Tangent, &mut Tangent)>,
+        path: DeviatoricPath,
+    ) -> Option<M3> {
+        match (path, self.newtonian_two_eta()) {
+            (DeviatoricPath::Auto, Some(two_eta)) => newtonian_stress(two_eta, f, fdot, tangents),
+            _ => self.deviatoric_stress_generic(f, fdot, tangents),
+        }
+    }
+
+    /// The generic kernel: any law, tangents by directional derivatives.
+    fn deviatoric_stress_generic(
+        &self,
+        f: &M3,
+        fdot: &M3,
+        tangents: Option<(&mut Tangent, &mut Tangent)>,
+    ) -> Option<M3> {
         let j = f.determinant();
         if !(j > 0.0) {
             return None;
@@ -340,6 +428,74 @@ impl Fluid {
         }
         (p * cof, j)
     }
+}
+
+/// Which kernel [`Fluid::deviatoric_stress_with`] uses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum DeviatoricPath {
+    /// The closed-form Newtonian kernel when the fluid is effectively Newtonian, the generic
+    /// one otherwise (what [`Fluid::deviatoric_stress`] does).
+    #[default]
+    Auto,
+    /// Always the generic kernel (for tests and benchmarks).
+    Generic,
+}
+
+/// Newtonian first Piola stress P = 2η J D Gᵀ (G = F⁻¹, L = Ḟ G, D = sym L, J = det F) with
+/// a constant `two_eta` = 2η, and optionally its tangents in closed form. Returns `None` if
+/// F is not invertible with positive determinant.
+///
+/// With c = 2ηJ, the derivatives along dF and dḞ are (dJ = J tr(G dF), dG = −G dF G):
+///
+/// - ∂P/∂F[dF] = c [tr(G dF) D Gᵀ − sym(L dF G) Gᵀ − D (G dF G)ᵀ],
+/// - ∂P/∂Ḟ[dḞ] = c sym(dḞ G) Gᵀ.
+///
+/// Taking dF = e_k e_Lᵀ and writing A = c D Gᵀ (= P), H = G Gᵀ and M = G L:
+///
+/// - ∂P_iJ/∂F_kL = G_Lk A_iJ − G_Jk A_iL − ½c (L_ik H_LJ + G_Li M_Jk),
+/// - ∂P_iJ/∂Ḟ_kL = ½c (δ_ik H_LJ + G_Li G_Jk),
+///
+/// 81 entries each from products precomputed once (three 3×3 products per point instead
+/// of about a hundred in the generic kernel).
+pub fn newtonian_stress(two_eta: f64, f: &M3, fdot: &M3, tangents: Option<(&mut Tangent, &mut Tangent)>) -> Option<M3> {
+    let j = f.determinant();
+    if !(j > 0.0) {
+        return None;
+    }
+    let g = f.try_inverse()?;
+    let l = fdot * g;
+    let d = 0.5 * (l + l.transpose());
+    let gt = g.transpose();
+    // the same operations as the generic kernel, so both give bit-identical stresses
+    let p = (two_eta * j) * d * gt;
+    if let Some((tf, tv)) = tangents {
+        let hc = 0.5 * two_eta * j;
+        let arr = |m: &M3| -> [[f64; 3]; 3] {
+            [[m[(0, 0)], m[(0, 1)], m[(0, 2)]], [m[(1, 0)], m[(1, 1)], m[(1, 2)]], [m[(2, 0)], m[(2, 1)], m[(2, 2)]]]
+        };
+        let a = arr(&p);
+        let gg = arr(&g);
+        let h = g * gt;
+        let lm = arr(&(hc * l));
+        let hm = arr(&h);
+        let mm = arr(&(g * l));
+        let gc = arr(&(hc * g));
+        let hcm = arr(&(hc * h));
+        for i in 0..3 {
+            for jj in 0..3 {
+                let (rf, rv) = (&mut tf[3 * i + jj], &mut tv[3 * i + jj]);
+                for k in 0..3 {
+                    let (lik, gjk, mjk) = (lm[i][k], gg[jj][k], mm[jj][k]);
+                    let delta = if i == k { 1.0 } else { 0.0 };
+                    for ll in 0..3 {
+                        rf[3 * k + ll] = gg[ll][k] * a[i][jj] - gjk * a[i][ll] - lik * hm[ll][jj] - gc[ll][i] * mjk;
+                        rv[3 * k + ll] = gc[ll][i] * gjk + delta * hcm[ll][jj];
+                    }
+                }
+            }
+        }
+    }
+    Some(p)
 }
 
 /// Deviatoric part of a 3×3 matrix.

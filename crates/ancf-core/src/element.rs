@@ -27,7 +27,7 @@ use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, Par};
 use nalgebra::Vector3;
 
-use crate::constitutive::{Fluid, M3, Tangent, cofactor, cofactor_derivative};
+use crate::constitutive::{DeviatoricPath, Fluid, M3, Tangent, cofactor, cofactor_derivative};
 use crate::error::{AncfError, Result, invalid};
 use crate::quadrature::{CubeRule, MAX_GAUSS_POINTS};
 use crate::shape::{N_COORDS, N_SHAPE, normalized_shape, slope_scale};
@@ -278,8 +278,25 @@ impl ElementRef {
         tables: &ShapeTables,
         (e, edot): (&Compact, &Compact),
         force: &mut [f64; N_COORDS],
+        jac: Option<(&mut [f64], &mut [f64])>,
+        path: VolumetricJacobian,
+    ) -> Result<()> {
+        self.internal_force_paths(index, fluid, tables, (e, edot), force, jac, path, DeviatoricPath::Auto)
+    }
+
+    /// [`ElementRef::internal_force_with`] with, in addition, the kernel of the deviatoric
+    /// stress chosen ([`DeviatoricPath`]; `Auto` takes the closed-form Newtonian kernel for an
+    /// effectively Newtonian fluid): the kernels are tested and benchmarked against each other.
+    pub fn internal_force_paths(
+        &self,
+        index: usize,
+        fluid: &Fluid,
+        tables: &ShapeTables,
+        (e, edot): (&Compact, &Compact),
+        force: &mut [f64; N_COORDS],
         mut jac: Option<(&mut [f64], &mut [f64])>,
         path: VolumetricJacobian,
+        deviatoric_path: DeviatoricPath,
     ) -> Result<()> {
         let structured = path == VolumetricJacobian::Structured;
         force.fill(0.0);
@@ -317,7 +334,7 @@ impl ElementRef {
                 }
                 let pk = if deviatoric {
                     let t = if want_t { Some((&mut tf, &mut tv)) } else { None };
-                    fluid.deviatoric_stress(&f, &fd, t).ok_or(AncfError::InvertedElement {
+                    fluid.deviatoric_stress_with(&f, &fd, t, deviatoric_path).ok_or(AncfError::InvertedElement {
                         element: index,
                         point: p,
                         j: f.determinant(),
