@@ -17,6 +17,41 @@
 //! Positions and velocities are mapped into the tank frame with the tank kinematics
 //! (R, A, Ṙ, ω): p = Aᵀ(r − R), v = Aᵀ(ṙ − Ṙ − ω × (r − R)). In a tank-frame formulation
 //! pass [`TankKinematics::identity`].
+//!
+//! # Culling (which points are checked)
+//!
+//! [`WallContact::forces`] skips, face by face, the points that provably touch no wall;
+//! the result is bit-identical to checking every point (`forces_full`). The points k of a
+//! group ("cell") of one boundary face are all interpolated from the same element's nodal
+//! vectors e_a with stored shape values S_ka. Since the position functions are a partition
+//! of unity, Σ_pos S_ka = 1 + η_k with |η_k| ≤ η (rounding of the stored values, ~1e-16,
+//! precomputed), and the tank-frame position is exactly
+//!
+//! p_k = Aᵀ(r_k − R) = w_o + Σ_a S_ka u_a + η_k (w_o + AᵀR),
+//!
+//! with w_a = Aᵀ(e_a − R), w_o their mean over the face's position nodes, u_a = w_a − w_o
+//! (positions; centring keeps the intervals below element-sized) and u_a = Aᵀe_a
+//! (gradients). With lo_a ≤ S_ka ≤ hi_a over the cell (precomputed), interval arithmetic
+//! puts every p_k in the box w_o + Σ_a [min(lo_a u_ai, hi_a u_ai), max(lo_a u_ai, hi_a u_ai)]
+//! ± η (|w_o| + ‖A‖_F |R|). If [`TankGeometry::box_clearance`] of that box (a lower bound on
+//! its distance to every point where a wall would be reported) exceeds a rounding margin of
+//! 10⁻⁹ × (tank size + |R| + the box's largest coordinate) — the rounding of these sums
+//! and of the point positions is below 10⁻¹³ of the same magnitudes — no point of the
+//! cell can hit a wall and it is skipped. Each face is tested as one cell and, if that
+//! fails, as 2×2 sub-cells. Faces whose points disagree on their bulkhead sides are
+//! always checked; non-finite data never culls.
+//!
+//! Trying the bound costs about as much as checking a few points, and faces on the walls
+//! are never culled, so it is tried only where it may pay off: on faces away from the
+//! walls in the reference state (the free surface, ...) whose node centroid is currently
+//! farther from the walls than a quarter of the face size. These heuristics only decide
+//! which faces are tried; they never change a result. Measured (`cargo bench -p ancf-core
+//! --bench contact`), the cull saves about as much as it costs on the tank-car meshes: the
+//! gain over the previous pass comes mostly from the leaner per-point work (velocity only
+//! at points that hit a wall, no Jacobian or Hessian work without `jacobians`, one gather
+//! of the nodal vectors per face, no allocation). The cull data is built by
+//! [`WallContact::new`]; treat `points` as read-only (if their number changes, `forces`
+//! falls back to the full check).
 
 use nalgebra::Vector3;
 
@@ -168,8 +203,69 @@ pub struct WallContact {
     pub geometry: TankGeometry,
     /// Contact law.
     pub law: WallContactLaw,
-    /// Contact points.
+    /// Contact points (grouped by boundary face; read-only after construction, see the
+    /// module docs on culling).
     pub points: Vec<ContactPoint>,
+    /// Cull data of each boundary face, in the order of `points`.
+    faces: Vec<FaceCull>,
+}
+
+/// Culling mode of [`WallContact::forces_counted`] (tests and benchmarks).
+#[doc(hidden)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Cull {
+    /// Check every point.
+    Off,
+    /// As [`WallContact::forces`]: try the bound on the faces worth it.
+    On,
+    /// Try the bound on every face (no performance heuristics), to test the bound.
+    Always,
+}
+
+/// Bit a set for the position functions (a = 0, 4, ..., 28).
+const POSITION_FUNCTIONS: u32 = 0x1111_1111;
+
+/// Faces are tried for culling only if their node centroid's clearance exceeds this
+/// fraction of their size (see `skip_mask`).
+const CULL_GATE: f64 = 0.25;
+
+/// A group of points of one face with its bound data (module docs, "Culling").
+#[derive(Debug, Clone)]
+struct CullCell {
+    /// Bit i set: point `start + i` of the face belongs to the cell.
+    mask: u64,
+    /// lo_a = min over the cell's points of S_ka.
+    lo: [f64; N_SHAPE],
+    /// hi_a = max over the cell's points of S_ka.
+    hi: [f64; N_SHAPE],
+}
+
+/// The points of one boundary face: `points[start..start + len]`, all of `element`.
+#[derive(Debug, Clone)]
+struct FaceCull {
+    start: usize,
+    len: usize,
+    element: usize,
+    /// Shape functions not identically zero on the face (bit a).
+    used: u32,
+    /// Bound on |Σ_pos S_ka − 1| over the face's points, rounding included.
+    eta: f64,
+    /// False: never culled (points on different bulkhead sides).
+    cullable: bool,
+    /// False: not worth trying (a face on the walls in the reference state, see
+    /// `WallContact::new`); [`Cull::Always`] tries it anyway.
+    candidate: bool,
+    /// The whole face first, then its 2×2 sub-cells.
+    cells: Vec<CullCell>,
+}
+
+/// Per-point accumulator of [`WallContact::point_force`]'s sums, hit by hit.
+struct PointAcc {
+    /// Walls hit so far.
+    hits: usize,
+    f: Vector3<f64>,
+    jp: M3,
+    jv: M3,
 }
 
 impl WallContact {
@@ -179,6 +275,8 @@ impl WallContact {
         law.validate()?;
         let (gx, gw) = gauss_legendre(law.points_per_edge)?;
         let mut points = Vec::new();
+        let mut faces = Vec::new();
+        let ppe = law.points_per_edge;
         for bf in &body.mesh.boundary {
             let el = bf.element;
             let r = &body.elements[el];
@@ -214,8 +312,28 @@ impl WallContact {
                     points.push(ContactPoint { element: el, shape, weight, sides });
                 }
             }
+            let start = points.len() - ppe * ppe;
+            faces.push(face_cull(&points[start..], start, el, ppe));
         }
-        Ok(Self { geometry, law, points })
+        // Try the cull only on faces whose node centroid is, in the reference state, away
+        // from the walls (free surface, ...): wall faces are hardly ever culled, and the
+        // test would cost more than it saves. A heuristic on performance only: any face
+        // may be checked in full.
+        let e0 = body.reference_coordinates();
+        for f in faces.iter_mut().filter(|f| f.cullable) {
+            let nodes = &body.mesh.elements[f.element];
+            let pos: Vec<Vector3<f64>> = (0..N_SHAPE)
+                .filter(|a| a % 4 == 0 && f.used >> a & 1 == 1)
+                .map(|a| {
+                    let g = 3 * (4 * nodes[a / 4]);
+                    Vector3::new(e0[g], e0[g + 1], e0[g + 2])
+                })
+                .collect();
+            let wo = pos.iter().sum::<Vector3<f64>>() / pos.len() as f64;
+            let size = pos.iter().fold(0.0f64, |m, x| m.max((x - wo).norm()));
+            f.candidate = geometry.clearance([wo[0], wo[1], wo[2]], &points[f.start].sides) > CULL_GATE * size;
+        }
+        Ok(Self { geometry, law, points, faces })
     }
 
     /// Position and velocity of a contact point (global).
@@ -235,7 +353,250 @@ impl WallContact {
 
     /// Add the contact generalized forces on the fluid to `out` and return the load on the
     /// tank. With `jacobians`, also collect the point Jacobians of every active point.
+    ///
+    /// Points that provably touch no wall are skipped (module docs, "Culling"); the
+    /// results are bit-identical to checking every point. No allocation besides pushes to
+    /// `jacobians`.
     pub fn forces(
+        &self,
+        body: &FluidBody,
+        kin: &TankKinematics,
+        e: &[f64],
+        edot: &[f64],
+        out: &mut [f64],
+        jacobians: Option<&mut Vec<PointJacobian>>,
+    ) -> ContactLoad {
+        self.forces_counted(body, kin, e, edot, out, jacobians, Cull::On).0
+    }
+
+    /// [`Self::forces`], also returning how many points were checked (positions
+    /// evaluated), with the cull as `cull` says (same results in every mode).
+    #[doc(hidden)]
+    #[allow(clippy::too_many_arguments)]
+    pub fn forces_counted(
+        &self,
+        body: &FluidBody,
+        kin: &TankKinematics,
+        e: &[f64],
+        edot: &[f64],
+        out: &mut [f64],
+        mut jacobians: Option<&mut Vec<PointJacobian>>,
+        cull: Cull,
+    ) -> (ContactLoad, usize) {
+        if self.faces.last().map_or(0, |f| f.start + f.len) != self.points.len() {
+            // `points` was edited after construction: the cull data no longer applies
+            return (self.forces_full(body, kin, e, edot, out, jacobians), self.points.len());
+        }
+        let mut load = ContactLoad::default();
+        let a_mat = kin.rotation;
+        let at = a_mat.transpose();
+        let rt = Vector3::from(kin.position);
+        let vt0 = Vector3::from(kin.velocity);
+        let w = Vector3::from(kin.angular_velocity);
+        let wt = w.cross_matrix();
+        let want_jac = jacobians.is_some();
+        if let Some(j) = jacobians.as_mut() {
+            j.clear();
+        }
+        let base_margin = self.geometry.size() + rt.norm();
+        let eta_scale = a_mat.norm() * rt.norm();
+        let mut checked = 0;
+        for face in &self.faces {
+            let nodes = &body.mesh.elements[face.element];
+            let mut g = [0usize; N_SHAPE];
+            let mut ea = [Vector3::zeros(); N_SHAPE];
+            for a in 0..N_SHAPE {
+                g[a] = 3 * (4 * nodes[a / 4] + a % 4);
+                ea[a] = Vector3::new(e[g[a]], e[g[a] + 1], e[g[a] + 2]);
+            }
+            let tried = face.cullable
+                && match cull {
+                    Cull::Off => false,
+                    Cull::On => face.candidate,
+                    Cull::Always => true,
+                };
+            let skip = if tried {
+                self.skip_mask(face, &ea, &at, &rt, base_margin, eta_scale, cull == Cull::Always)
+            } else {
+                0
+            };
+            for i in 0..face.len {
+                if skip >> i & 1 == 1 {
+                    continue;
+                }
+                let k = face.start + i;
+                let pt = &self.points[k];
+                checked += 1;
+                // the same operations, in the same order, as `forces_full`
+                let mut r = Vector3::zeros();
+                for a in 0..N_SHAPE {
+                    r += pt.shape[a] * ea[a];
+                }
+                let d = r - rt;
+                let p = at * d;
+                let mut acc = PointAcc { hits: 0, f: Vector3::zeros(), jp: M3::zeros(), jv: M3::zeros() };
+                let mut v: Option<Vector3<f64>> = None;
+                self.geometry.for_each_hit_with([p[0], p[1], p[2]], &pt.sides, want_jac, |h| {
+                    // the velocity only where some wall is hit
+                    let v = *v.get_or_insert_with(|| {
+                        let mut rd = Vector3::zeros();
+                        for a in 0..N_SHAPE {
+                            rd += pt.shape[a] * Vector3::new(edot[g[a]], edot[g[a] + 1], edot[g[a] + 2]);
+                        }
+                        at * (rd - vt0 - w.cross(&d))
+                    });
+                    self.add_hit(&mut acc, &h, &v, pt.weight, want_jac);
+                    load.max_penetration = load.max_penetration.max(h.psi);
+                });
+                if acc.hits == 0 {
+                    continue;
+                }
+                let f = a_mat * acc.f;
+                load.active += 1;
+                for a in 0..N_SHAPE {
+                    let o = &mut out[g[a]..g[a] + 3];
+                    for i in 0..3 {
+                        o[i] += pt.shape[a] * f[i];
+                    }
+                }
+                let m = d.cross(&(-f));
+                for i in 0..3 {
+                    load.force[i] -= f[i];
+                    load.moment[i] += m[i];
+                }
+                if let Some(j) = jacobians.as_mut() {
+                    let dv = a_mat * acc.jv * at;
+                    let dp = a_mat * acc.jp * at - dv * wt;
+                    j.push(PointJacobian { point: k, d_position: dp, d_velocity: dv, force: f, arm: d });
+                }
+            }
+        }
+        (load, checked)
+    }
+
+    /// Bit i set: point `face.start + i` provably hits no wall (module docs, "Culling").
+    fn skip_mask(
+        &self,
+        face: &FaceCull,
+        ea: &[Vector3<f64>; N_SHAPE],
+        at: &M3,
+        rt: &Vector3<f64>,
+        base_margin: f64,
+        eta_scale: f64,
+        ungated: bool,
+    ) -> u64 {
+        let used = |mut bits: u32| {
+            std::iter::from_fn(move || {
+                (bits != 0).then(|| {
+                    let a = bits.trailing_zeros() as usize;
+                    bits &= bits - 1;
+                    a
+                })
+            })
+        };
+        // u_a = Aᵀ(e_a − R) − w_o (positions; w_o: their mean over the face), Aᵀe_a (gradients)
+        let mut u = [Vector3::zeros(); N_SHAPE];
+        let mut wo = Vector3::zeros();
+        let mut n = 0.0;
+        let pos = face.used & POSITION_FUNCTIONS;
+        for a in used(pos) {
+            u[a] = at * (ea[a] - rt);
+            wo += u[a];
+            n += 1.0;
+        }
+        wo /= n;
+        let mut spread = 0.0f64;
+        for a in used(pos) {
+            u[a] -= wo;
+            spread = spread.max(u[a].norm_squared());
+        }
+        let sides = &self.points[face.start].sides;
+        // Cheap gate (a heuristic: it only decides whether to try the bound): a face whose
+        // node centroid is closer to a wall than a fraction of the face's size is hardly
+        // ever culled (faces on the walls), and trying costs more than it saves.
+        if !ungated && !(self.geometry.clearance([wo[0], wo[1], wo[2]], sides) > CULL_GATE * spread.sqrt()) {
+            return 0;
+        }
+        for a in used(face.used & !POSITION_FUNCTIONS) {
+            u[a] = at * ea[a];
+        }
+        let slack = face.eta * (wo.norm() + eta_scale);
+        let clear = |cell: &CullCell| {
+            let mut lo = [wo[0] - slack, wo[1] - slack, wo[2] - slack];
+            let mut hi = [wo[0] + slack, wo[1] + slack, wo[2] + slack];
+            for a in used(face.used) {
+                for i in 0..3 {
+                    let (x, y) = (cell.lo[a] * u[a][i], cell.hi[a] * u[a][i]);
+                    lo[i] += x.min(y);
+                    hi[i] += x.max(y);
+                }
+            }
+            let extent = lo.iter().chain(&hi).fold(0.0f64, |m, v| m.max(v.abs()));
+            let margin = 1e-9 * (base_margin + extent);
+            self.geometry.box_clearance(lo, hi, sides) > margin
+        };
+        if clear(&face.cells[0]) {
+            return face.cells[0].mask;
+        }
+        face.cells[1..].iter().filter(|cell| clear(cell)).fold(0, |m, cell| m | cell.mask)
+    }
+
+    /// Adds one wall hit to a point's force (and Jacobians if `jac`): the operations of
+    /// [`Self::point_force`] for that hit, in the same order.
+    fn add_hit(&self, acc: &mut PointAcc, h: &WallHit, v: &Vector3<f64>, w: f64, jac: bool) {
+        let (k, c) = (self.law.stiffness, self.law.damping);
+        acc.hits += 1;
+        let g = Vector3::from(h.grad);
+        let hm = h.hess;
+        let psi = h.psi;
+        let psid = g.dot(v);
+        let fnorm = psi * (k + c * psid);
+        // (without `jac`, hm is zero and only the force is used)
+        let hv = if jac { hm * v } else { Vector3::zeros() };
+        let (fnorm, dfn_dp, dfn_dv) = if fnorm > 0.0 {
+            (fnorm, (k + c * psid) * g + (c * psi) * hv, (c * psi) * g)
+        } else {
+            (0.0, Vector3::zeros(), Vector3::zeros())
+        };
+        acc.f -= w * fnorm * g;
+        if jac {
+            acc.jp -= w * (g * dfn_dp.transpose() + fnorm * hm);
+            acc.jv -= w * g * dfn_dv.transpose();
+        }
+        if matches!(self.law.friction, WallFriction::Frictionless) {
+            return;
+        }
+        let q = g.dot(&g);
+        let s = psid;
+        let vt = v - (s / q) * g;
+        match self.law.friction {
+            WallFriction::Frictionless => {}
+            WallFriction::Coulomb { coefficient: mu, slip_velocity: eps } => {
+                let m = (vt.dot(&vt) + eps * eps).sqrt();
+                acc.f -= w * mu * fnorm * vt / m;
+                if jac {
+                    let (dvt_dp, dvt_dv) = tangential_jacobians(&g, &hm, &hv, q, s);
+                    let dir = M3::identity() / m - vt * vt.transpose() / (m * m * m);
+                    acc.jp -= w * mu * (vt / m * dfn_dp.transpose() + fnorm * dir * dvt_dp);
+                    acc.jv -= w * mu * (vt / m * dfn_dv.transpose() + fnorm * dir * dvt_dv);
+                }
+            }
+            WallFriction::NoSlip { drag, activation_depth } => {
+                let (chi, dchi) = smoothstep(psi / activation_depth);
+                acc.f -= w * drag * chi * vt;
+                if jac {
+                    let (dvt_dp, dvt_dv) = tangential_jacobians(&g, &hm, &hv, q, s);
+                    acc.jp -= w * drag * (vt * (dchi / activation_depth) * g.transpose() + chi * dvt_dp);
+                    acc.jv -= w * drag * chi * dvt_dv;
+                }
+            }
+        }
+    }
+
+    /// [`Self::forces`] checking every point, without culling: the reference the culled
+    /// pass must reproduce bit for bit (tests, benchmarks).
+    #[doc(hidden)]
+    pub fn forces_full(
         &self,
         body: &FluidBody,
         kin: &TankKinematics,
@@ -338,6 +699,54 @@ impl WallContact {
         }
         (f, jp, jv)
     }
+}
+
+/// ∂v_t/∂p and ∂v_t/∂v of v_t = v − (s/q) ∇ψ, s = ∇ψ·v, q = |∇ψ|² (as in `point_force`).
+fn tangential_jacobians(g: &Vector3<f64>, hm: &M3, hv: &Vector3<f64>, q: f64, s: f64) -> (M3, M3) {
+    let dvt_dv = M3::identity() - g * g.transpose() / q;
+    let hg = hm * g;
+    let dvt_dp = -(g * hv.transpose() / q + (s / q) * hm - (2.0 * s / (q * q)) * g * hg.transpose());
+    (dvt_dp, dvt_dv)
+}
+
+/// Cull data of one face from its points (`pts`, in the order of [`WallContact::new`]:
+/// point i·ppe + j at the i-th Gauss abscissa along one face direction and the j-th along
+/// the other).
+fn face_cull(pts: &[ContactPoint], start: usize, element: usize, ppe: usize) -> FaceCull {
+    let cell = |members: &dyn Fn(usize, usize) -> bool| {
+        let mut c = CullCell { mask: 0, lo: [f64::INFINITY; N_SHAPE], hi: [f64::NEG_INFINITY; N_SHAPE] };
+        for i in 0..ppe {
+            for j in 0..ppe {
+                if members(i, j) {
+                    let k = i * ppe + j;
+                    c.mask |= 1 << k;
+                    for a in 0..N_SHAPE {
+                        c.lo[a] = c.lo[a].min(pts[k].shape[a]);
+                        c.hi[a] = c.hi[a].max(pts[k].shape[a]);
+                    }
+                }
+            }
+        }
+        c
+    };
+    let mut cells = vec![cell(&|_, _| true)];
+    if ppe > 1 {
+        for bi in 0..2 {
+            for bj in 0..2 {
+                cells.push(cell(&|i, j| 2 * i / ppe == bi && 2 * j / ppe == bj));
+            }
+        }
+    }
+    let mut used = 0u32;
+    for a in 0..N_SHAPE {
+        if cells[0].lo[a] != 0.0 || cells[0].hi[a] != 0.0 {
+            used |= 1 << a;
+        }
+    }
+    // the rounding of the 8-term sums (each |S_ka| < 2) is far below 1e-14
+    let eta = pts.iter().fold(0.0f64, |m, p| m.max(((0..8).map(|n| p.shape[4 * n]).sum::<f64>() - 1.0).abs())) + 1e-14;
+    let cullable = eta < 1e-10 && pts.iter().all(|p| p.sides == pts[0].sides);
+    FaceCull { start, len: pts.len(), element, used, eta, cullable, candidate: cullable, cells }
 }
 
 /// Scatter point Jacobians into a dense global matrix (tests and small problems):

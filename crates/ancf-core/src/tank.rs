@@ -125,16 +125,27 @@ impl TankGeometry {
 
     /// Every wall with ψ > 0 at `p` (tank frame). `side` gives, for each bulkhead, the
     /// side of its liquid (−1: x < x_b, +1: x > x_b). Walls are independent: at a corner
-    /// two walls may be active at once and both push.
+    /// two walls may be active at once and both push. Same walls, in the same order, as
+    /// [`Self::for_each_hit`].
     pub fn hits(&self, p: [f64; 3], side: &[i8], out: &mut Vec<WallHit>) {
         out.clear();
+        self.for_each_hit(p, side, |h| out.push(h));
+    }
+
+    /// Calls `sink` with every wall with ψ > 0 at `p` (tank frame), in a fixed order
+    /// (shell walls, then the bulkheads in the order of `bulkheads`); no allocation. See
+    /// [`Self::hits`].
+    ///
+    /// At most 3 shell walls are active at once (a box corner; cylinders: shell + one
+    /// end), plus one per bulkhead whose liquid side the point has left.
+    pub fn for_each_hit(&self, p: [f64; 3], side: &[i8], sink: impl FnMut(WallHit)) {
+        self.for_each_hit_with(p, side, true, sink);
+    }
+
+    /// [`Self::for_each_hit`]; with `hessian` false, every `hess` is left zero (the same
+    /// ψ and ∇ψ, bit for bit; for callers that need no Jacobian).
+    pub(crate) fn for_each_hit_with(&self, p: [f64; 3], side: &[i8], hessian: bool, mut sink: impl FnMut(WallHit)) {
         let [x, y, z] = p;
-        let plane = |n: [f64; 3], d: f64, out: &mut Vec<WallHit>| {
-            let psi = n[0] * x + n[1] * y + n[2] * z - d;
-            if psi > 0.0 {
-                out.push(WallHit { psi, grad: n, hess: M3::zeros() });
-            }
-        };
         match self.shape {
             TankShape::Cylinder { length, radius: r, head_depth: hd } => {
                 let xc = 0.5 * length;
@@ -143,41 +154,43 @@ impl TankGeometry {
                     if rho - r > 0.0 {
                         let n = [0.0, y / rho, z / rho];
                         let mut h = M3::zeros();
-                        for i in 1..3 {
-                            for j in 1..3 {
-                                h[(i, j)] = (if i == j { 1.0 } else { 0.0 } - n[i] * n[j]) / rho;
+                        if hessian {
+                            for i in 1..3 {
+                                for j in 1..3 {
+                                    h[(i, j)] = (if i == j { 1.0 } else { 0.0 } - n[i] * n[j]) / rho;
+                                }
                             }
                         }
-                        out.push(WallHit { psi: rho - r, grad: n, hess: h });
+                        sink(WallHit { psi: rho - r, grad: n, hess: h });
                     }
                 }
                 if hd == 0.0 {
-                    plane([1.0, 0.0, 0.0], xc, out);
-                    plane([-1.0, 0.0, 0.0], xc, out);
+                    plane(p, [1.0, 0.0, 0.0], xc, &mut sink);
+                    plane(p, [-1.0, 0.0, 0.0], xc, &mut sink);
                 } else if x.abs() > xc {
                     let dx = x - xc * x.signum();
                     let inv = [1.0 / (hd * hd), 1.0 / (r * r), 1.0 / (r * r)];
                     let q = [dx, y, z];
-                    if let Some(h) = quadric_hit(&q, &inv, r) {
-                        out.push(h);
+                    if let Some(h) = quadric_hit(&q, &inv, r, hessian) {
+                        sink(h);
                     }
                 }
             }
             TankShape::EllipticCylinder { length, semi_axis_y: a, semi_axis_z: b } => {
                 let inv = [0.0, 1.0 / (a * a), 1.0 / (b * b)];
-                if let Some(h) = quadric_hit(&[0.0, y, z], &inv, (a * b).sqrt()) {
-                    out.push(h);
+                if let Some(h) = quadric_hit(&[0.0, y, z], &inv, (a * b).sqrt(), hessian) {
+                    sink(h);
                 }
-                plane([1.0, 0.0, 0.0], 0.5 * length, out);
-                plane([-1.0, 0.0, 0.0], 0.5 * length, out);
+                plane(p, [1.0, 0.0, 0.0], 0.5 * length, &mut sink);
+                plane(p, [-1.0, 0.0, 0.0], 0.5 * length, &mut sink);
             }
             TankShape::Box { min, max } => {
                 for d in 0..3 {
                     let mut n = [0.0; 3];
                     n[d] = 1.0;
-                    plane(n, max[d], out);
+                    plane(p, n, max[d], &mut sink);
                     n[d] = -1.0;
-                    plane(n, -min[d], out);
+                    plane(p, n, -min[d], &mut sink);
                 }
             }
         }
@@ -185,8 +198,95 @@ impl TankGeometry {
             let s = *s as f64;
             let psi = 0.5 * b.thickness - s * (x - b.x);
             if psi > 0.0 {
-                out.push(WallHit { psi, grad: [-s, 0.0, 0.0], hess: M3::zeros() });
+                sink(WallHit { psi, grad: [-s, 0.0, 0.0], hess: M3::zeros() });
             }
+        }
+    }
+
+    /// Clearance of `p` (tank frame): a lower bound c on the distance from `p` to the set
+    /// H of points at which [`Self::hits`] reports a wall (for bulkhead sides `side`). Every
+    /// point q with |q − p| ≤ c, c > 0, has no wall hit; c ≤ 0 says nothing.
+    /// Equal to [`Self::box_clearance`] of the box [p, p].
+    pub fn clearance(&self, p: [f64; 3], side: &[i8]) -> f64 {
+        self.box_clearance(p, p, side)
+    }
+
+    /// A lower bound c on the distance from every point of the box [`lo`, `hi`] (tank
+    /// frame, lo ≤ hi) to the set H of points at which [`Self::hits`] reports a wall (for
+    /// bulkhead sides `side`); c > 0: no point within c of the box has a wall hit.
+    ///
+    /// Derivation, wall by wall: c is the minimum over the walls of a lower bound on the
+    /// distance from the box to a set containing that wall's part of H. With
+    /// X, Y, Z the largest |x|, |y|, |z| over the box (X about the head centre):
+    /// - plane n·q > d (axis normal): d − max over the box of n·q, exact;
+    /// - cylindrical shell {ρ > R}: R − √(Y² + Z²) (every box point has ρ ≤ √(Y² + Z²),
+    ///   and the distance from ρ to the exterior of the disc is R − ρ);
+    /// - elliptic shell {y²/a² + z²/b² > 1}: with the gauge g = √(y²/a² + z²/b²) ≤
+    ///   g_max = √(Y²/a² + Z²/b²), m = min(a, b) and E the (convex) ellipse: (y, z) ∈ gE
+    ///   and the disc of radius m lies in E, so (y, z) + u ∈ gE + (1 − g)E = E for
+    ///   |u| ≤ (1 − g)m: c = (1 − g_max) m;
+    /// - head at x_c (depth d, radius R), active for x > x_c only: H ⊂ {x > x_c} ∩
+    ///   {φ > 1}, φ = (x − x_c)²/d² + ρ²/R²; the distance is ≥ x_c − max x (half-space)
+    ///   and ≥ (1 − √φ_max) min(d, R) (the ellipsoid argument above in 3-D, with
+    ///   φ ≤ φ_max = X²/d² + (Y² + Z²)/R²), so ≥ their maximum (mirrored at −x_c);
+    /// - bulkhead at x_b, thickness t, liquid side s: H = {s(x − x_b) < t/2}:
+    ///   c = min over the box of s(x − x_b) − t/2, exact.
+    ///
+    /// Computed in floating point: callers that need a strict guarantee must keep a margin
+    /// of many ulps of the tank size (see `contact.rs`). Non-finite input gives −∞.
+    pub fn box_clearance(&self, lo: [f64; 3], hi: [f64; 3], side: &[i8]) -> f64 {
+        // (f64::min ignores NaN: a non-finite box gets no clearance at all)
+        if !lo.iter().chain(&hi).all(|v| v.is_finite()) {
+            return f64::NEG_INFINITY;
+        }
+        let amax = |d: usize| lo[d].abs().max(hi[d].abs());
+        let (yy, zz) = (amax(1), amax(2));
+        let mut c = match self.shape {
+            TankShape::Cylinder { length, radius: r, head_depth: hd } => {
+                let xc = 0.5 * length;
+                let rho = (yy * yy + zz * zz).sqrt();
+                let shell = r - rho;
+                if hd == 0.0 {
+                    shell.min(xc - hi[0]).min(lo[0] + xc)
+                } else {
+                    let m = hd.min(r);
+                    let q = rho * rho / (r * r);
+                    let head = |xx: f64| (1.0 - (xx * xx / (hd * hd) + q).sqrt()) * m;
+                    let front = (xc - hi[0]).max(head((lo[0] - xc).abs().max((hi[0] - xc).abs())));
+                    let rear = (lo[0] + xc).max(head((lo[0] + xc).abs().max((hi[0] + xc).abs())));
+                    shell.min(front).min(rear)
+                }
+            }
+            TankShape::EllipticCylinder { length, semi_axis_y: a, semi_axis_z: b } => {
+                let g = (yy * yy / (a * a) + zz * zz / (b * b)).sqrt();
+                let h = 0.5 * length;
+                ((1.0 - g) * a.min(b)).min(h - hi[0]).min(lo[0] + h)
+            }
+            TankShape::Box { min, max } => {
+                let mut c = f64::INFINITY;
+                for d in 0..3 {
+                    c = c.min(max[d] - hi[d]).min(lo[d] - min[d]);
+                }
+                c
+            }
+        };
+        for (b, s) in self.bulkheads.iter().zip(side) {
+            // min over the box of s(x − x_b)
+            let s = *s as f64;
+            let gap = if s > 0.0 { s * (lo[0] - b.x) } else { s * (hi[0] - b.x) };
+            c = c.min(gap - 0.5 * b.thickness);
+        }
+        c
+    }
+
+    /// A length scale of the tank: the largest absolute coordinate of its interior.
+    pub fn size(&self) -> f64 {
+        match self.shape {
+            TankShape::Cylinder { length, radius, head_depth } => (0.5 * length + head_depth).max(radius),
+            TankShape::EllipticCylinder { length, semi_axis_y, semi_axis_z } => {
+                (0.5 * length).max(semi_axis_y).max(semi_axis_z)
+            }
+            TankShape::Box { min, max } => min.iter().chain(&max).fold(0.0f64, |m, v| m.max(v.abs())),
         }
     }
 
@@ -204,8 +304,16 @@ fn self_axial_extent(shape: &TankShape) -> (f64, f64) {
     }
 }
 
-/// ψ = s(√φ − 1) with φ = Σ q_i² inv_i, if positive.
-fn quadric_hit(q: &[f64; 3], inv: &[f64; 3], s: f64) -> Option<WallHit> {
+/// A plane wall n·p = d: its hit, if ψ = n·p − d > 0.
+fn plane(p: [f64; 3], n: [f64; 3], d: f64, sink: &mut impl FnMut(WallHit)) {
+    let psi = n[0] * p[0] + n[1] * p[1] + n[2] * p[2] - d;
+    if psi > 0.0 {
+        sink(WallHit { psi, grad: n, hess: M3::zeros() });
+    }
+}
+
+/// ψ = s(√φ − 1) with φ = Σ q_i² inv_i, if positive (∇²ψ only with `hessian`).
+fn quadric_hit(q: &[f64; 3], inv: &[f64; 3], s: f64, hessian: bool) -> Option<WallHit> {
     let phi: f64 = (0..3).map(|i| q[i] * q[i] * inv[i]).sum();
     let sq = phi.sqrt();
     let psi = s * (sq - 1.0);
@@ -216,10 +324,12 @@ fn quadric_hit(q: &[f64; 3], inv: &[f64; 3], s: f64) -> Option<WallHit> {
     let gphi = [2.0 * inv[0] * q[0], 2.0 * inv[1] * q[1], 2.0 * inv[2] * q[2]];
     let grad = [s * gphi[0] / (2.0 * sq), s * gphi[1] / (2.0 * sq), s * gphi[2] / (2.0 * sq)];
     let mut hess = M3::zeros();
-    for i in 0..3 {
-        for j in 0..3 {
-            let d = if i == j { 2.0 * inv[i] / (2.0 * sq) } else { 0.0 };
-            hess[(i, j)] = s * (d - gphi[i] * gphi[j] / (4.0 * phi * sq));
+    if hessian {
+        for i in 0..3 {
+            for j in 0..3 {
+                let d = if i == j { 2.0 * inv[i] / (2.0 * sq) } else { 0.0 };
+                hess[(i, j)] = s * (d - gphi[i] * gphi[j] / (4.0 * phi * sq));
+            }
         }
     }
     Some(WallHit { psi, grad, hess })
