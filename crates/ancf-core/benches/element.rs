@@ -18,8 +18,11 @@
 //! (`DeviatoricPath::Generic`, 9 directional derivatives), alternated in the same run, medians:
 //! per point (stress alone, and stress + both 9×9 tangents, over 1024 random states) and per
 //! element (force + Jacobians, and force alone, over the first 64 elements).
+//! A fourth table times the batched body force (1024 elements) and element force + Jacobians
+//! (64 elements) with and without clearing the vector registers after faer's GEMMs
+//! (`ancf_core::simd`), alternated in the same run.
 //! Pass a filter argument (e.g. `cargo bench --bench element -- quick`) for fewer repetitions;
-//! `newtonian` runs the third table only.
+//! `newtonian` runs the third table only, `simd` the fourth only.
 //!
 //! Caution: on the AVX-512 development machine, scalar (SSE) code that runs after a faer GEMM
 //! is 2–4× slower until the upper vector-register state is cleared (faer's kernels leave it
@@ -59,10 +62,95 @@ fn main() {
     let reps = if quick { 5 } else { 21 };
     let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
     let mesh = box_mesh([0.0; 3], [2.0, 1.0, 1.0], [16, 8, 8]).unwrap(); // 1024 elements
-    if !std::env::args().any(|a| a == "newtonian") {
+    let only = |name: &str| std::env::args().any(|a| a == name);
+    if only("simd") {
+        pool.install(|| simd_table(&mesh, reps));
+        return;
+    }
+    if !only("newtonian") {
         kernel_tables(&mesh, reps, &pool);
     }
     newtonian_table(&mesh, reps);
+    pool.install(|| simd_table(&mesh, reps));
+}
+
+/// Batched body force and element force + Jacobians with and without `vzeroupper` after
+/// faer's GEMMs ([`ancf_core::simd`]), side by side (ABBA), one thread.
+fn simd_table(mesh: &ancf_core::FluidMesh, reps: usize) {
+    use ancf_core::simd::set_clear_upper_simd;
+    println!();
+    println!("vector-register clearing after faer GEMMs, 1 thread, ABBA, median of {} samples", reps * CHUNKS);
+    println!(
+        "{:<26} {:>6} {:>16} {:>16} {:>8} {:>16} {:>16} {:>8}",
+        "fluid", "rule", "force dirty ns", "force clear ns", "speedup", "f+jac dirty us", "f+jac clear us", "speedup"
+    );
+    let fluids = [
+        ("newtonian (light crude)", Fluid::new(850.0, Rheology::Newtonian { viscosity: 0.005 }, 1.25e7).unwrap()),
+        (
+            "oldroyd (heavy crude)",
+            Fluid::new(
+                1000.0,
+                Rheology::Oldroyd { viscosity: 100.0, yield_stress: 100.0, elastic_modulus: None },
+                1.25e7,
+            )
+            .unwrap(),
+        ),
+    ];
+    for (name, fluid) in fluids {
+        for (nv, np) in [(3, 3), (3, 4)] {
+            let body =
+                FluidBody::new(mesh.clone(), fluid, QuadratureOptions { viscous: nv, penalty: np, mass: 4 }).unwrap();
+            let mut rng = Rng::new(2);
+            let e: Vec<f64> = body.reference_coordinates().iter().map(|x| x + 0.002 * rng.uniform()).collect();
+            let v: Vec<f64> = e.iter().map(|_| 0.1 * rng.uniform()).collect();
+            let nel = body.mesh.elements.len();
+            let force = |clear: bool| {
+                let mut out = vec![0.0; body.n_coords()];
+                let (body, e, v) = (&body, &e, &v);
+                move |_c: usize| {
+                    set_clear_upper_simd(clear);
+                    let t = Instant::now();
+                    body.internal_forces(e, v, &mut out).unwrap();
+                    black_box(&out);
+                    t.elapsed().as_secs_f64() / nel as f64
+                }
+            };
+            let (fd, fc) = side_by_side(reps, force(false), force(true));
+            let els: Vec<_> =
+                (0..64).map(|el| (body.element_coordinates(el, &e), body.element_coordinates(el, &v))).collect();
+            let jac = |clear: bool| {
+                let mut f = [0.0; ancf_core::shape::N_COORDS];
+                let mut k = vec![0.0; ancf_core::shape::N_COORDS * ancf_core::shape::N_COORDS];
+                let mut c = k.clone();
+                let (body, els) = (&body, &els);
+                move |chunk: usize| {
+                    set_clear_upper_simd(clear);
+                    let t = Instant::now();
+                    let m = els.len() / CHUNKS;
+                    for (el, (ec, vc)) in els.iter().enumerate().skip(chunk * m).take(m) {
+                        let r = &body.elements[el];
+                        r.internal_force(el, &body.fluid, &body.tables, ec, vc, &mut f, Some((&mut k, &mut c)))
+                            .unwrap();
+                        black_box(&f);
+                    }
+                    t.elapsed().as_secs_f64() / m as f64
+                }
+            };
+            let (jd, jc) = side_by_side(reps, jac(false), jac(true));
+            set_clear_upper_simd(true);
+            println!(
+                "{:<26} {:>6} {:>16.0} {:>16.0} {:>7.2}x {:>16.1} {:>16.1} {:>7.2}x",
+                name,
+                format!("{nv}^3+{np}^3"),
+                1e9 * fd,
+                1e9 * fc,
+                fd / fc,
+                1e6 * jd,
+                1e6 * jc,
+                jd / jc
+            );
+        }
+    }
 }
 
 /// Chunks the work of [`newtonian_table`] is timed in (so that a sample lasts well under a

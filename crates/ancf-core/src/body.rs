@@ -28,6 +28,52 @@ use crate::shape::{COORDS_PER_NODE, N_COORDS, N_SHAPE};
 /// Elements per batched chunk.
 const CHUNK: usize = 64;
 
+/// Reusable buffers of [`FluidBody::internal_forces_with`]: one set per chunk of
+/// elements, sized on first use. A workspace can serve any body (it is resized when the
+/// chunks change); reusing it makes the force evaluation allocation-free.
+#[derive(Debug, Clone, Default)]
+pub struct ForceWorkspace {
+    chunks: Vec<ChunkBuffers>,
+}
+
+/// Buffers of one chunk of [`CHUNK`] elements (see [`FluidBody::batched_chunk`]).
+#[derive(Debug, Clone)]
+struct ChunkBuffers {
+    /// Scaled coordinates and velocities, 32 × 6n_b.
+    ehat: Mat<f64>,
+    /// ∂r/∂ξ and ∂ṙ/∂ξ at the points, 3n_p × 6n_b.
+    fh: Mat<f64>,
+    /// Scaled stresses, 3n_p × 3n_b.
+    ph: Mat<f64>,
+    /// Scaled forces, 32 × 3n_b.
+    fo: Mat<f64>,
+    /// Element forces of the chunk.
+    out: Vec<[f64; N_COORDS]>,
+    /// Outcome of the chunk's last evaluation.
+    status: Result<()>,
+}
+
+impl ChunkBuffers {
+    fn new() -> Self {
+        Self { ehat: Mat::new(), fh: Mat::new(), ph: Mat::new(), fo: Mat::new(), out: Vec::new(), status: Ok(()) }
+    }
+
+    /// Sizes the buffers for `nb` elements and `npt` force points (no allocation when
+    /// the sizes are unchanged).
+    fn size(&mut self, nb: usize, npt: usize) {
+        let fit = |m: &mut Mat<f64>, r: usize, c: usize| {
+            if m.nrows() != r || m.ncols() != c {
+                *m = Mat::zeros(r, c);
+            }
+        };
+        fit(&mut self.ehat, N_SHAPE, 6 * nb);
+        fit(&mut self.fh, 3 * npt, 6 * nb);
+        fit(&mut self.ph, 3 * npt, 3 * nb);
+        fit(&mut self.fo, N_SHAPE, 3 * nb);
+        self.out.resize(nb, [0.0; N_COORDS]);
+    }
+}
+
 /// Dense per-element Jacobians of the internal force.
 #[derive(Debug, Clone)]
 pub struct ElementJacobian {
@@ -207,6 +253,30 @@ impl FluidBody {
         (0..self.elements.len()).into_par_iter().map(|el| self.element_tangent(el, e, edot).map(|x| x.1)).collect()
     }
 
+    /// [`Self::element_jacobians`] into `out`, reusing its storage (no allocation once it
+    /// holds one Jacobian per element; rayon's scheduling may allocate with more than one
+    /// thread). Identical values.
+    pub fn element_jacobians_into(&self, e: &[f64], edot: &[f64], out: &mut Vec<ElementJacobian>) -> Result<()> {
+        self.check_state(e, edot)?;
+        let n2 = N_COORDS * N_COORDS;
+        out.resize_with(self.elements.len(), || ElementJacobian { stiffness: vec![0.0; n2], damping: vec![0.0; n2] });
+        out.par_iter_mut().enumerate().try_for_each(|(el, jac)| {
+            let mut f = [0.0; N_COORDS];
+            let ec = self.element_coordinates(el, e);
+            let ed = self.element_coordinates(el, edot);
+            // Zeroes the Jacobians before accumulating into them.
+            self.elements[el].internal_force(
+                el,
+                &self.fluid,
+                &self.tables,
+                &ec,
+                &ed,
+                &mut f,
+                Some((&mut jac.stiffness, &mut jac.damping)),
+            )
+        })
+    }
+
     /// Generalized internal forces f(e, ė) (viscous + penalty), element by element with
     /// the scalar kernel. Reference implementation for [`Self::internal_forces`].
     pub fn internal_forces_scalar(&self, e: &[f64], edot: &[f64], out: &mut [f64]) -> Result<()> {
@@ -224,23 +294,42 @@ impl FluidBody {
     }
 
     /// Generalized internal forces f(e, ė), batched and parallel. Deterministic.
+    /// Allocates its buffers; [`Self::internal_forces_with`] reuses them.
     pub fn internal_forces(&self, e: &[f64], edot: &[f64], out: &mut [f64]) -> Result<()> {
+        self.internal_forces_with(&mut ForceWorkspace::default(), e, edot, out)
+    }
+
+    /// [`Self::internal_forces`] with reusable buffers: no allocation once `ws` has been
+    /// used with this body (on the calling thread with one rayon thread; rayon's own
+    /// scheduling may allocate with more). Results are bitwise identical for any thread
+    /// count and to [`Self::internal_forces`].
+    pub fn internal_forces_with(
+        &self,
+        ws: &mut ForceWorkspace,
+        e: &[f64],
+        edot: &[f64],
+        out: &mut [f64],
+    ) -> Result<()> {
         self.check_state(e, edot)?;
         check_len("out", out.len(), self.n_coords())?;
         let nel = self.elements.len();
-        let chunks: Vec<Result<Vec<[f64; N_COORDS]>>> = (0..nel.div_ceil(CHUNK))
-            .into_par_iter()
-            .map(|c| {
-                let lo = c * CHUNK;
-                let hi = (lo + CHUNK).min(nel);
-                self.batched_chunk(lo, hi, e, edot)
-            })
-            .collect();
+        let npt = self.tables.viscous.len() + self.tables.penalty.len();
+        let n_chunks = nel.div_ceil(CHUNK);
+        if ws.chunks.len() != n_chunks {
+            ws.chunks.resize_with(n_chunks, ChunkBuffers::new);
+        }
+        ws.chunks.par_iter_mut().enumerate().for_each(|(c, buf)| {
+            let lo = c * CHUNK;
+            let hi = (lo + CHUNK).min(nel);
+            buf.size(hi - lo, npt);
+            buf.status = self.batched_chunk(lo, hi, e, edot, buf);
+        });
         out.fill(0.0);
         let mut el = 0;
-        for ch in chunks {
-            for f in ch? {
-                self.scatter(el, &f, out);
+        for buf in &mut ws.chunks {
+            std::mem::replace(&mut buf.status, Ok(()))?;
+            for f in &buf.out {
+                self.scatter(el, f, out);
                 el += 1;
             }
         }
@@ -262,12 +351,14 @@ impl FluidBody {
         }
     }
 
-    /// Forces of elements `lo..hi` through two GEMMs.
-    fn batched_chunk(&self, lo: usize, hi: usize, e: &[f64], edot: &[f64]) -> Result<Vec<[f64; N_COORDS]>> {
-        let nb = hi - lo;
+    /// Forces of elements `lo..hi` through two GEMMs, into `buf.out` (`buf` sized for
+    /// the chunk by [`ChunkBuffers::size`]).
+    fn batched_chunk(&self, lo: usize, hi: usize, e: &[f64], edot: &[f64], buf: &mut ChunkBuffers) -> Result<()> {
         let nv = self.tables.viscous.len();
         let npt = nv + self.tables.penalty.len();
-        let mut ehat = Mat::<f64>::zeros(N_SHAPE, 6 * nb);
+        let ChunkBuffers { ehat, fh, ph, fo, out, .. } = buf;
+        // Every entry of `ehat`, `fh`, `fo` and `out` is written below; `ph` keeps zeros in
+        // the rows of the points that are skipped.
         for (b, el) in (lo..hi).enumerate() {
             let nodes = &self.mesh.elements[el];
             let scale = &self.elements[el].scale;
@@ -279,10 +370,12 @@ impl FluidBody {
                 }
             }
         }
-        let mut fh = Mat::<f64>::zeros(3 * npt, 6 * nb);
         matmul(fh.as_mut(), Accum::Replace, self.dn_t.as_ref(), ehat.as_ref(), 1.0, Par::Seq);
-        let mut ph = Mat::<f64>::zeros(3 * npt, 3 * nb);
+        crate::clear_upper_simd();
         let has_penalty = self.fluid.bulk_penalty != 0.0 || self.fluid.bulk_damping != 0.0;
+        if !has_penalty {
+            ph.fill(0.0);
+        }
         for (b, el) in (lo..hi).enumerate() {
             let r = &self.elements[el];
             for p in 0..npt {
@@ -317,9 +410,8 @@ impl FluidBody {
                 }
             }
         }
-        let mut fo = Mat::<f64>::zeros(N_SHAPE, 3 * nb);
         matmul(fo.as_mut(), Accum::Replace, self.dn_t.transpose(), ph.as_ref(), 1.0, Par::Seq);
-        let mut out = vec![[0.0; N_COORDS]; nb];
+        crate::clear_upper_simd();
         for (b, el) in (lo..hi).enumerate() {
             let scale = &self.elements[el].scale;
             for a in 0..N_SHAPE {
@@ -331,7 +423,7 @@ impl FluidBody {
                 return Err(AncfError::NonFinite { what: "element internal force".into(), element: el });
             }
         }
-        Ok(out)
+        Ok(())
     }
 }
 
@@ -376,4 +468,66 @@ pub fn rigid_motion(e: &[f64], rot: &M3, t: [f64; 3], omega: [f64; 3], v: [f64; 
         d.copy_from_slice(dv.as_slice());
     }
     (out, vel)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::constitutive::Rheology;
+    use crate::mesh::box_mesh;
+
+    /// Coordinates and velocities.
+    type State = (Vec<f64>, Vec<f64>);
+
+    /// A 5×2×1 box mesh and three deformed, moving states.
+    fn body_and_states(bulk_penalty: f64) -> (FluidBody, Vec<State>) {
+        let mesh = box_mesh([0.0; 3], [2.0, 1.0, 0.5], [5, 2, 1]).unwrap();
+        let fluid = Fluid::new(900.0, Rheology::Newtonian { viscosity: 0.3 }, bulk_penalty).unwrap();
+        let body = FluidBody::new(mesh, fluid, QuadratureOptions::default()).unwrap();
+        let e0 = body.reference_coordinates();
+        let states = (0..3)
+            .map(|k| {
+                let s = 0.01 * (k + 1) as f64;
+                let e: Vec<f64> =
+                    e0.iter().enumerate().map(|(i, x)| x + s * ((i * 7 % 13) as f64 / 13.0 - 0.5)).collect();
+                let v: Vec<f64> = (0..e0.len()).map(|i| s * ((i * 5 % 11) as f64 / 11.0 - 0.5)).collect();
+                (e, v)
+            })
+            .collect();
+        (body, states)
+    }
+
+    /// A reused workspace gives bit-identical forces to fresh buffers, state after state,
+    /// with and without the penalty terms (whose skipped rows must stay zero).
+    #[test]
+    fn reused_force_workspace_is_bit_identical() {
+        for penalty in [2e6, 0.0] {
+            let (body, states) = body_and_states(penalty);
+            let mut ws = ForceWorkspace::default();
+            let n = body.n_coords();
+            for (e, v) in &states {
+                let (mut fresh, mut reused) = (vec![0.0; n], vec![1.0; n]);
+                body.internal_forces(e, v, &mut fresh).unwrap();
+                body.internal_forces_with(&mut ws, e, v, &mut reused).unwrap();
+                assert!(fresh.iter().any(|x| *x != 0.0));
+                assert_eq!(fresh, reused, "penalty {penalty}");
+            }
+        }
+    }
+
+    /// Reused element Jacobians equal freshly computed ones, state after state.
+    #[test]
+    fn reused_element_jacobians_are_identical() {
+        let (body, states) = body_and_states(2e6);
+        let mut jacs = Vec::new();
+        for (e, v) in &states {
+            let fresh = body.element_jacobians(e, v).unwrap();
+            body.element_jacobians_into(e, v, &mut jacs).unwrap();
+            assert_eq!(jacs.len(), fresh.len());
+            for (a, b) in fresh.iter().zip(&jacs) {
+                assert_eq!(a.stiffness, b.stiffness);
+                assert_eq!(a.damping, b.damping);
+            }
+        }
+    }
 }

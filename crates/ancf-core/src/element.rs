@@ -393,26 +393,35 @@ fn assemble_tangents(
         return;
     }
     // only the first 3·np columns are filled (a skipped penalty pass leaves the rest unused)
+    let bcat_full = bcat;
     let bcat = bcat.as_ref().subcols(0, 3 * np);
     let mut bt = Mat::<f64>::zeros(2 * N_SHAPE, 3 * np);
     let mut out = Mat::<f64>::zeros(2 * N_SHAPE, N_SHAPE);
     for i in 0..3 {
         for kk in 0..3 {
             for (p, (tk, tc)) in tangents.iter().enumerate() {
-                for a in 0..N_SHAPE {
-                    let b = [bcat[(a, 3 * p)], bcat[(a, 3 * p + 1)], bcat[(a, 3 * p + 2)]];
-                    for l in 0..3 {
-                        let (mut sk, mut sc) = (0.0, 0.0);
-                        for j in 0..3 {
-                            sk += b[j] * tk[3 * i + j][3 * kk + l];
-                            sc += b[j] * tc[3 * i + j][3 * kk + l];
-                        }
-                        bt[(a, 3 * p + l)] = sk;
-                        bt[(N_SHAPE + a, 3 * p + l)] = sc;
+                // the 3×3 blocks T_p[i·][k·] of both tangents, then column by column of B·T
+                let blk = |t: &Tangent| {
+                    let r = |j: usize| [t[3 * i + j][3 * kk], t[3 * i + j][3 * kk + 1], t[3 * i + j][3 * kk + 2]];
+                    [r(0), r(1), r(2)]
+                };
+                let (bk, bc) = (blk(tk), blk(tc));
+                let b0: &[f64; N_SHAPE] = bcat_full.col_as_slice(3 * p).try_into().unwrap();
+                let b1: &[f64; N_SHAPE] = bcat_full.col_as_slice(3 * p + 1).try_into().unwrap();
+                let b2: &[f64; N_SHAPE] = bcat_full.col_as_slice(3 * p + 2).try_into().unwrap();
+                for l in 0..3 {
+                    let col: &mut [f64; 2 * N_SHAPE] = bt.col_as_slice_mut(3 * p + l).try_into().unwrap();
+                    let (ck, cc) = col.split_at_mut(N_SHAPE);
+                    let (k0, k1, k2) = (bk[0][l], bk[1][l], bk[2][l]);
+                    let (c0, c1, c2) = (bc[0][l], bc[1][l], bc[2][l]);
+                    for a in 0..N_SHAPE {
+                        ck[a] = b0[a] * k0 + b1[a] * k1 + b2[a] * k2;
+                        cc[a] = b0[a] * c0 + b1[a] * c1 + b2[a] * c2;
                     }
                 }
             }
             matmul(out.as_mut(), Accum::Replace, bt.as_ref(), bcat.transpose(), 1.0, Par::Seq);
+            crate::clear_upper_simd();
             for a in 0..N_SHAPE {
                 let row = (3 * a + i) * N_COORDS;
                 for b in 0..N_SHAPE {
@@ -520,12 +529,14 @@ impl VolumetricTangents {
         let mut out = Mat::<f64>::zeros(N_COORDS, N_COORDS);
         let v = self.v.as_ref().subcols(0, n);
         matmul(out.as_mut(), Accum::Replace, self.w.as_ref().subcols(0, n), v.transpose(), 1.0, Par::Seq);
+        crate::clear_upper_simd();
         for (r, row) in k.chunks_exact_mut(N_COORDS).enumerate() {
             for (kk, x) in row.iter_mut().zip(out.col(r).iter()) {
                 *kk += x;
             }
         }
         matmul(out.as_mut(), Accum::Replace, self.cv.as_ref().subcols(0, n), v.transpose(), 1.0, Par::Seq);
+        crate::clear_upper_simd();
         for (r, row) in c.chunks_exact_mut(N_COORDS).enumerate() {
             for (cc, x) in row.iter_mut().zip(out.col(r).iter()) {
                 *cc += x;
@@ -536,6 +547,7 @@ impl VolumetricTangents {
         // ε_ikl for (i, k) ≠: l = 3 − i − k, sign +1 for cyclic (i, k, l)
         for (l, y) in self.y.iter().enumerate() {
             matmul(x.as_mut(), Accum::Replace, y.as_ref().subcols(0, 3 * n), b.transpose(), 1.0, Par::Seq);
+            crate::clear_upper_simd();
             let (i, kk) = ((l + 1) % 3, (l + 2) % 3); // ε_{i kk l} = +1
             for a in 0..N_SHAPE {
                 for bb in 0..N_SHAPE {

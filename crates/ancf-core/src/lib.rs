@@ -27,6 +27,7 @@ pub mod error;
 pub mod mesh;
 pub mod quadrature;
 pub mod shape;
+pub mod simd;
 pub mod tank;
 pub mod validate;
 
@@ -35,3 +36,5 @@ pub use constitutive::{Fluid, Rheology};
 pub use element::QuadratureOptions;
 pub use error::{AncfError, Result};
 pub use mesh::FluidMesh;
+
+pub use simd::clear_upper_simd;

@@ -9,15 +9,15 @@
 //!
 //! Its pattern (the union of the dynamics pattern, the diagonal, `C_q` and `C_qᵀ`) is
 //! fixed when the solver is built; [`KktSolver::assemble`] writes values through a
-//! precomputed map into the CSC value array, so no allocation happens per Newton
-//! iteration on our side. (faer's high-level `Lu::try_new_with_symbolic` and
-//! `solve_in_place` allocate their own scratch; see the TODO in [`KktSolver`].)
+//! precomputed map into the CSC value array. The LU goes through faer's low-level API
+//! with a persistent [`NumericLu`] and a persistent scratch [`MemBuffer`], so neither a
+//! solve nor (after the first) a numeric refactorization allocates.
 
-use faer::MatMut;
-use faer::linalg::solvers::Solve;
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::sparse::linalg::LuError;
-use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
+use faer::sparse::linalg::lu::{NumericLu, SymbolicLu, factorize_symbolic_lu};
 use faer::sparse::{Pair, SparseColMat, SymbolicSparseColMat};
+use faer::{Conj, MatMut, Par};
 
 use super::error::KktIndex;
 use super::iterative::{BlockJacobi, CsrView, Gmres, IterativeParams, LinearSolverKind};
@@ -36,9 +36,6 @@ pub(crate) enum LinearFailure {
 }
 
 /// Sparse KKT matrix with its symbolic LU and the latest numeric LU.
-///
-/// TODO(perf): use faer's low-level `factorize_numeric_lu` with a persistent
-/// `NumericLu` and `MemBuffer` to make refactorizations allocation-free.
 pub(crate) struct KktSolver {
     n: usize,
     m: usize,
@@ -56,12 +53,47 @@ pub(crate) struct KktSolver {
     residual_tol: f64,
     /// Largest absolute matrix entry at the last factorization.
     a_max: f64,
+    /// Scratch of the factorization and the solves (grown on demand, then reused).
+    scratch: Scratch,
+}
+
+/// A reusable faer scratch buffer that grows to the largest requirement seen.
+struct Scratch {
+    req: StackReq,
+    buffer: MemBuffer,
+}
+
+impl Scratch {
+    fn new() -> Self {
+        Self { req: StackReq::EMPTY, buffer: MemBuffer::new(StackReq::EMPTY) }
+    }
+
+    /// A stack of at least `req`; allocates only when `req` exceeds every earlier one.
+    fn stack(&mut self, req: StackReq) -> Result<&mut MemStack, LinearFailure> {
+        let grown = self.req.or(req);
+        if grown != self.req {
+            self.buffer = MemBuffer::try_new(grown).map_err(|e| LinearFailure::Generic(format!("{e:?}")))?;
+            self.req = grown;
+        }
+        Ok(MemStack::new(&mut self.buffer))
+    }
+}
+
+/// The parallelism of the factorization and the solves: sequential, always. faer's
+/// supernodal LU splits its work by the number of rayon threads, so with its global
+/// setting the last bits of the solution (and so the trajectories) changed with
+/// `RAYON_NUM_THREADS` on the 6×4×2 tank-car mesh; sequential, they do not
+/// (`fluid_car_results_do_not_depend_on_the_thread_count`). The LU of these KKT matrices
+/// gained nothing measurable from threads (`docs/benchmarks.md`).
+fn parallelism() -> Par {
+    Par::Seq
 }
 
 /// The factorization behind [`KktSolver`].
 enum Backend {
-    /// Sparse LU: symbolic factorization once, numeric LU per refresh.
-    Direct { symbolic: SymbolicLu<usize>, lu: Option<Lu<usize, f64>> },
+    /// Sparse LU: symbolic factorization once, numeric LU per refresh (into the same
+    /// [`NumericLu`], whose storage is reused); `factored` when it holds a valid LU.
+    Direct { symbolic: Box<SymbolicLu<usize>>, numeric: Box<NumericLu<usize, f64>>, factored: bool },
     /// GMRES with block Jacobi: "factorizing" inverts the diagonal blocks.
     Iterative {
         params: IterativeParams,
@@ -106,9 +138,12 @@ impl KktSolver {
         let matrix = SparseColMat::new(symbolic, vec![0.0; nnz]);
         let backend = match kind {
             LinearSolverKind::Direct => Backend::Direct {
-                symbolic: SymbolicLu::try_new(matrix.symbolic())
-                    .map_err(|e| LinearFailure::Generic(format!("{e:?}")))?,
-                lu: None,
+                symbolic: Box::new(
+                    factorize_symbolic_lu(matrix.symbolic(), Default::default())
+                        .map_err(|e| LinearFailure::Generic(format!("{e:?}")))?,
+                ),
+                numeric: Box::new(NumericLu::new()),
+                factored: false,
             },
             LinearSolverKind::Iterative(params) => {
                 if m > 0 {
@@ -142,6 +177,7 @@ impl KktSolver {
             work: vec![0.0; dim],
             residual_tol,
             a_max: 0.0,
+            scratch: Scratch::new(),
         })
     }
 
@@ -181,15 +217,14 @@ impl KktSolver {
     /// Numeric LU of the current values, reusing the symbolic factorization.
     pub(crate) fn factorize(&mut self) -> Result<(), LinearFailure> {
         match &mut self.backend {
-            Backend::Direct { lu, .. } => *lu = None,
-            Backend::Iterative { factored, .. } => *factored = false,
+            Backend::Direct { factored, .. } | Backend::Iterative { factored, .. } => *factored = false,
         }
         if self.matrix.val().iter().any(|v| !v.is_finite()) {
             return Err(LinearFailure::Numeric(None));
         }
         self.a_max = inf_norm(self.matrix.val());
-        let (symbolic, lu_slot) = match &mut self.backend {
-            Backend::Direct { symbolic, lu } => (symbolic, lu),
+        let (symbolic, numeric, factored) = match &mut self.backend {
+            Backend::Direct { symbolic, numeric, factored } => (symbolic, numeric, factored),
             Backend::Iterative { csr, prec, factored, .. } => {
                 csr.gather(self.matrix.val());
                 prec.factor(csr).map_err(LinearFailure::NoPivot)?;
@@ -197,14 +232,24 @@ impl KktSolver {
                 return Ok(());
             }
         };
+        let par = parallelism();
+        let stack = self.scratch.stack(symbolic.factorize_numeric_lu_scratch::<f64>(par, Default::default()))?;
         // faer 0.24 can panic on some zero pivots (faer-rs issue #232); turn that into
         // an error instead of unwinding through the integrator.
+        let matrix = self.matrix.as_ref();
         let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            Lu::try_new_with_symbolic(symbolic.clone(), self.matrix.as_ref())
+            symbolic.factorize_numeric_lu(numeric, matrix, par, stack, Default::default()).map(|_| ())
         }));
+        // faer's dense kernels leave the vector registers dirty (`ancf_core::simd`).
+        ancf_core::clear_upper_simd();
+        if !matches!(result, Ok(Ok(()))) {
+            // Failed or unwound mid-factorization: start the next one from an empty numeric
+            // LU rather than from a partly written one (allocates again, on failures only).
+            **numeric = NumericLu::new();
+        }
         match result {
-            Ok(Ok(lu)) => {
-                *lu_slot = Some(lu);
+            Ok(Ok(())) => {
+                *factored = true;
                 Ok(())
             }
             Ok(Err(LuError::SymbolicSingular { index })) => Err(LinearFailure::NoPivot(index)),
@@ -218,9 +263,9 @@ impl KktSolver {
     /// refinement if the residual is too large.
     pub(crate) fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearFailure> {
         let dim = self.n + self.m;
-        let lu = match &mut self.backend {
-            Backend::Direct { lu: Some(lu), .. } => lu,
-            Backend::Direct { lu: None, .. } | Backend::Iterative { factored: false, .. } => {
+        let (symbolic, numeric) = match &mut self.backend {
+            Backend::Direct { symbolic, numeric, factored: true } => (&**symbolic, &**numeric),
+            Backend::Direct { factored: false, .. } | Backend::Iterative { factored: false, .. } => {
                 return Err(LinearFailure::Numeric(None));
             }
             Backend::Iterative { params, csr, prec, gmres, iterations, .. } => {
@@ -234,8 +279,14 @@ impl KktSolver {
                 return if report.converged { Ok(()) } else { Err(LinearFailure::Numeric(None)) };
             }
         };
+        let par = parallelism();
+        let stack = self.scratch.stack(symbolic.solve_in_place_scratch::<f64>(1, par))?;
+        // `numeric` is the output of `symbolic.factorize_numeric_lu` for this matrix pattern
+        // (`factored` is set only after it succeeded).
+        let lu = faer::sparse::linalg::lu::LuRef::new_unchecked(symbolic, numeric);
         self.rhs_copy.copy_from_slice(rhs);
-        lu.solve_in_place(MatMut::from_column_major_slice_mut(rhs, dim, 1));
+        lu.solve_in_place_with_conj(Conj::No, MatMut::from_column_major_slice_mut(rhs, dim, 1), par, stack);
+        ancf_core::clear_upper_simd();
         for refinement in 0..2 {
             if let Some(i) = rhs.iter().position(|v| !v.is_finite()) {
                 return Err(LinearFailure::Numeric(Some(KktIndex::from_raw(i, self.n))));
@@ -259,7 +310,13 @@ impl KktSolver {
             if refinement == 1 {
                 break;
             }
-            lu.solve_in_place(MatMut::from_column_major_slice_mut(&mut self.work, dim, 1));
+            lu.solve_in_place_with_conj(
+                Conj::No,
+                MatMut::from_column_major_slice_mut(&mut self.work, dim, 1),
+                par,
+                &mut *stack,
+            );
+            ancf_core::clear_upper_simd();
             for (x, d) in rhs.iter_mut().zip(&self.work) {
                 *x += d;
             }

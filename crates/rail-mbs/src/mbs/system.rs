@@ -43,6 +43,41 @@ pub struct Multibody {
     forces: Vec<Box<dyn ForceElement>>,
     wheelsets: Vec<WheelsetContact>,
     layout: Option<std::sync::Arc<Layout>>,
+    /// Reusable buffers of the callbacks (no allocation per call once sized).
+    scratch: Scratch,
+}
+
+/// Buffers reused by the [`MechanicalSystem`] callbacks of [`Multibody`].
+#[derive(Debug, Default)]
+struct Scratch {
+    /// All zeros, length `n` (velocities of the constraint evaluations).
+    zeros: Vec<f64>,
+    /// Perturbed coordinates and velocities of the finite differences.
+    q: Vec<f64>,
+    v: Vec<f64>,
+}
+
+impl Scratch {
+    /// `zeros` resized to `n` (stays all zeros: it is never written).
+    fn zeros(&mut self, n: usize) {
+        self.zeros.resize(n, 0.0);
+    }
+
+    /// Copies of `q` and `v` to perturb, taken out of the scratch (give them back with
+    /// [`Self::put`]).
+    fn take(&mut self, q: &[f64], v: &[f64]) -> (Vec<f64>, Vec<f64>) {
+        let (mut qq, mut vv) = (std::mem::take(&mut self.q), std::mem::take(&mut self.v));
+        qq.clear();
+        qq.extend_from_slice(q);
+        vv.clear();
+        vv.extend_from_slice(v);
+        (qq, vv)
+    }
+
+    fn put(&mut self, (q, v): (Vec<f64>, Vec<f64>)) {
+        self.q = q;
+        self.v = v;
+    }
 }
 
 #[derive(Debug, Clone)]
@@ -313,6 +348,41 @@ impl Multibody {
         let wr: Wrench = w.wrench(&s).map_err(|e| SystemError::Other(format!("wheelset contact '{}': {e}", w.name)))?;
         Ok(s.generalized(&wr.force, &wr.moment))
     }
+
+    /// Forward-difference Jacobians of the wheel/rail contact wrenches (each evaluation
+    /// scans the profiles), scattered into `dq`, `dv`. `qq`, `vv` hold copies of `q`, `v`.
+    fn wheelset_jacobians(
+        &mut self,
+        q: &[f64],
+        v: &[f64],
+        (qq, vv): (&mut [f64], &mut [f64]),
+        layout: &Layout,
+        dq: &mut [f64],
+        dv: &mut [f64],
+    ) -> Result<(), SystemError> {
+        let mut jq = [[0.0; 14]; 14];
+        let mut jv = [[0.0; 14]; 14];
+        for k in 0..self.wheelsets.len() {
+            let b = self.wheelsets[k].body.0;
+            let f0 = self.wheelset_forces(k, q, v)?;
+            for c in 0..7 {
+                let g = 7 * b + c;
+                qq[g] = q[g] + FD_Q;
+                let fp = self.wheelset_forces(k, qq, vv)?;
+                qq[g] = q[g];
+                vv[g] = v[g] + FD_V;
+                let gp = self.wheelset_forces(k, qq, vv)?;
+                vv[g] = v[g];
+                for r in 0..7 {
+                    jq[r][c] = (fp[r] - f0[r]) / FD_Q;
+                    jv[r][c] = (gp[r] - f0[r]) / FD_V;
+                }
+            }
+            scatter(layout, [Some(b), None], &jq, dq);
+            scatter(layout, [Some(b), None], &jv, dv);
+        }
+        Ok(())
+    }
 }
 
 /// Scatters a dense local block (rows/cols of up to two bodies) into pattern values.
@@ -462,8 +532,7 @@ impl MechanicalSystem for Multibody {
             scatter(&layout, [Some(b), None], &jv, dv);
         }
         // Force elements (central differences over the coordinates of their bodies).
-        let mut qq = q.to_vec();
-        let mut vv = v.to_vec();
+        let (mut qq, mut vv) = self.scratch.take(q, v);
         for e in 0..self.forces.len() {
             let bodies = self.forces[e].bodies().map(|a| a.map(|b| b.0));
             clear(&mut jq);
@@ -493,39 +562,21 @@ impl MechanicalSystem for Multibody {
             scatter(&layout, bodies, &jv, dv);
         }
         // Wheel/rail contacts (forward differences: each evaluation scans the profiles).
-        for k in 0..self.wheelsets.len() {
-            let b = self.wheelsets[k].body.0;
-            let f0 = self.wheelset_forces(k, q, v)?;
-            clear(&mut jq);
-            clear(&mut jv);
-            for c in 0..7 {
-                let g = 7 * b + c;
-                qq[g] = q[g] + FD_Q;
-                let fp = self.wheelset_forces(k, &qq, &vv)?;
-                qq[g] = q[g];
-                vv[g] = v[g] + FD_V;
-                let gp = self.wheelset_forces(k, &qq, &vv)?;
-                vv[g] = v[g];
-                for r in 0..7 {
-                    jq[r][c] = (fp[r] - f0[r]) / FD_Q;
-                    jv[r][c] = (gp[r] - f0[r]) / FD_V;
-                }
-            }
-            scatter(&layout, [Some(b), None], &jq, dq);
-            scatter(&layout, [Some(b), None], &jv, dv);
-        }
-        Ok(())
+        let result = self.wheelset_jacobians(q, v, (&mut qq, &mut vv), &layout, dq, dv);
+        self.scratch.put((qq, vv));
+        result
     }
 
     fn constraints(&mut self, t: f64, q: &[f64], out: &mut [f64]) -> Result<(), SystemError> {
         let layout = self.layout();
-        let zeros = vec![0.0; q.len()];
+        self.scratch.zeros(q.len());
+        let zeros = &self.scratch.zeros;
         for b in 0..self.bodies.len() {
             let p = &q[7 * b + 3..7 * b + 7];
             out[b] = p.iter().map(|x| x * x).sum::<f64>() - 1.0;
         }
         for (k, j) in self.joints.iter().enumerate() {
-            let (si, sj) = (self.state(j.body_i, q, &zeros), self.state(j.body_j, q, &zeros));
+            let (si, sj) = (self.state(j.body_i, q, zeros), self.state(j.body_j, q, zeros));
             let r = layout.joint_rows[k];
             j.evaluate(t, &si, &sj, &mut out[r..r + j.n_equations()], None);
         }
@@ -534,7 +585,8 @@ impl MechanicalSystem for Multibody {
 
     fn constraint_jacobian(&mut self, t: f64, q: &[f64], values: &mut [f64]) -> Result<(), SystemError> {
         let layout = self.layout();
-        let zeros = vec![0.0; q.len()];
+        self.scratch.zeros(q.len());
+        let zeros = &self.scratch.zeros;
         for b in 0..self.bodies.len() {
             for k in 0..4 {
                 values[4 * b + k] = 2.0 * q[7 * b + 3 + k];
@@ -543,7 +595,7 @@ impl MechanicalSystem for Multibody {
         let mut c = [0.0; 6];
         let mut jac = [[0.0; 14]; 6];
         for (k, j) in self.joints.iter().enumerate() {
-            let (si, sj) = (self.state(j.body_i, q, &zeros), self.state(j.body_j, q, &zeros));
+            let (si, sj) = (self.state(j.body_i, q, zeros), self.state(j.body_j, q, zeros));
             let n = j.n_equations();
             j.evaluate(t, &si, &sj, &mut c[..n], Some(&mut jac[..n]));
             let mut idx = layout.joint_entries[k];
@@ -567,7 +619,7 @@ impl MechanicalSystem for Multibody {
         dq: &mut [f64],
     ) -> Result<bool, SystemError> {
         let layout = self.layout();
-        let zeros = vec![0.0; q.len()];
+        self.scratch.zeros(q.len());
         // Normalization: ∂(2 p λ)/∂p = 2 λ I.
         for (b, lam) in lambda.iter().enumerate().take(self.bodies.len()) {
             let base = layout.blocks[&(b, b)];
@@ -575,7 +627,8 @@ impl MechanicalSystem for Multibody {
                 dq[base + 7 * k + k] += 2.0 * lam;
             }
         }
-        let mut qq = q.to_vec();
+        let (mut qq, vv) = self.scratch.take(q, &[]);
+        let zeros = &self.scratch.zeros;
         let mut c = [0.0; 6];
         let mut jp = [[0.0; 14]; 6];
         let mut jm = [[0.0; 14]; 6];
@@ -592,16 +645,16 @@ impl MechanicalSystem for Multibody {
                     qq[g] = q[g] + FD_Q;
                     j.evaluate(
                         t,
-                        &self.state(j.body_i, &qq, &zeros),
-                        &self.state(j.body_j, &qq, &zeros),
+                        &self.state(j.body_i, &qq, zeros),
+                        &self.state(j.body_j, &qq, zeros),
                         &mut c,
                         Some(&mut jp[..n]),
                     );
                     qq[g] = q[g] - FD_Q;
                     j.evaluate(
                         t,
-                        &self.state(j.body_i, &qq, &zeros),
-                        &self.state(j.body_j, &qq, &zeros),
+                        &self.state(j.body_i, &qq, zeros),
+                        &self.state(j.body_j, &qq, zeros),
                         &mut c,
                         Some(&mut jm[..n]),
                     );
@@ -614,6 +667,7 @@ impl MechanicalSystem for Multibody {
             }
             scatter(&layout, bodies, &local, dq);
         }
+        self.scratch.put((qq, vv));
         Ok(true)
     }
 }

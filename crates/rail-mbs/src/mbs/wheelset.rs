@@ -44,13 +44,16 @@ impl WheelsetContact {
         Ok(WheelsetReport { points: [l.evaluate(&p)?, r.evaluate(&p)?] })
     }
 
-    /// Total contact wrench on the wheelset about its centre of mass.
+    /// Total contact wrench on the wheelset about its centre of mass (no allocation once
+    /// the contacts' buffers have grown).
     pub fn wrench(&mut self, state: &BodyState) -> Result<Wrench, ContactError> {
-        let rep = self.evaluate(state)?;
+        let p = pose(state);
         let mut w = Wrench::default();
-        for p in rep.points.iter().flatten() {
-            w.force += p.force_on_wheel();
-            w.moment += p.moment_on_wheel(&state.position);
+        for wheel in &mut self.wheels {
+            for c in wheel.evaluate_cached(&p)? {
+                w.force += c.force_on_wheel();
+                w.moment += c.moment_on_wheel(&state.position);
+            }
         }
         Ok(w)
     }

@@ -15,6 +15,7 @@
 use std::collections::HashMap;
 
 use ancf_core::FluidBody;
+use ancf_core::body::{ElementJacobian, ForceWorkspace};
 use ancf_core::constitutive::M3;
 use ancf_core::contact::{ContactLoad, PointJacobian, TankKinematics, WallContact};
 use ancf_core::error::AncfError;
@@ -66,6 +67,9 @@ pub struct SloshSystem {
     blocks: HashMap<(usize, usize), usize>,
     element_blocks: Vec<[usize; 64]>,
     point_jac: Vec<PointJacobian>,
+    /// Reused buffers: force evaluation and element Jacobians.
+    workspace: ForceWorkspace,
+    jacobians: Vec<ElementJacobian>,
 }
 
 /// Default penetration limit relative to the smallest element edge: a contact point
@@ -91,8 +95,9 @@ pub(crate) fn subtract_element_jacobians(
     edot: &[f64],
     dq: &mut [f64],
     dv: &mut [f64],
+    jacs: &mut Vec<ElementJacobian>,
 ) -> Result<(), SystemError> {
-    let jacs = body.element_jacobians(e, edot).map_err(sys_err)?;
+    body.element_jacobians_into(e, edot, jacs).map_err(sys_err)?;
     for (el, jac) in jacs.iter().enumerate() {
         let eb = &element_blocks[el];
         for a in 0..N_SHAPE {
@@ -160,6 +165,8 @@ impl SloshSystem {
             blocks,
             element_blocks,
             point_jac: Vec::new(),
+            workspace: ForceWorkspace::default(),
+            jacobians: Vec::new(),
         })
     }
 
@@ -288,7 +295,7 @@ impl MechanicalSystem for SloshSystem {
     }
 
     fn forces(&mut self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) -> Result<(), SystemError> {
-        self.body.internal_forces(q, v, out).map_err(sys_err)?;
+        self.body.internal_forces_with(&mut self.workspace, q, v, out).map_err(sys_err)?;
         out.iter_mut().for_each(|x| *x = -*x);
         let gs = self.body.gravity_scale();
         let (g, alin) = match self.frame {
@@ -355,7 +362,7 @@ impl MechanicalSystem for SloshSystem {
         dq: &mut [f64],
         dv: &mut [f64],
     ) -> Result<(), SystemError> {
-        subtract_element_jacobians(&self.body, &self.element_blocks, q, v, dq, dv)?;
+        subtract_element_jacobians(&self.body, &self.element_blocks, q, v, dq, dv, &mut self.jacobians)?;
         if let Some((b, wc)) = self.rotation_terms(t) {
             let m = self.body.scalar_mass().as_ref();
             for j in 0..m.ncols() {

@@ -25,6 +25,7 @@
 use std::collections::HashMap;
 
 use ancf_core::FluidBody;
+use ancf_core::body::{ElementJacobian, ForceWorkspace};
 use ancf_core::contact::{PointJacobian, TankKinematics, WallContact};
 use ancf_core::error::AncfError;
 use ancf_core::shape::N_SHAPE;
@@ -75,6 +76,13 @@ pub struct FluidVehicle {
     mb_entries: usize,
     n_rigid: usize,
     point_jac: Vec<PointJacobian>,
+    /// Force buffers of each fluid (no allocation per force evaluation).
+    workspaces: Vec<ForceWorkspace>,
+    /// Element Jacobians (buffer reused by every fluid).
+    jacobians: Vec<ElementJacobian>,
+    /// Contact-force buffers of the step check and the finite differences (fluid length;
+    /// zeroed before each use: the contact adds into them).
+    scratch: [Vec<f64>; 2],
 }
 
 fn sys_err(e: AncfError) -> SystemError {
@@ -105,7 +113,18 @@ impl FluidVehicle {
             }
         }
         let mb_entries = mb.pattern().dynamics.len();
-        let mut s = Self { mb, fluids, layouts: Vec::new(), mb_entries, n_rigid, point_jac: Vec::new() };
+        let workspaces = vec![ForceWorkspace::default(); fluids.len()];
+        let mut s = Self {
+            mb,
+            fluids,
+            layouts: Vec::new(),
+            mb_entries,
+            n_rigid,
+            point_jac: Vec::new(),
+            workspaces,
+            jacobians: Vec::new(),
+            scratch: Default::default(),
+        };
         let (_, layouts) = s.build_pattern();
         s.layouts = layouts;
         Ok(s)
@@ -274,7 +293,7 @@ impl MechanicalSystem for FluidVehicle {
             let n = f.body.n_coords();
             let (e, ed) = (&q[lay.offset..lay.offset + n], &v[lay.offset..lay.offset + n]);
             let of = &mut out[lay.offset..lay.offset + n];
-            f.body.internal_forces(e, ed, of).map_err(sys_err)?;
+            f.body.internal_forces_with(&mut self.workspaces[k], e, ed, of).map_err(sys_err)?;
             of.iter_mut().for_each(|x| *x = -*x);
             for (s, o) in f.body.gravity_scale().iter().zip(of.chunks_exact_mut(3)) {
                 for i in 0..3 {
@@ -298,16 +317,20 @@ impl MechanicalSystem for FluidVehicle {
     /// its tank wall deeper than half its smallest element edge (as `SloshSystem`).
     fn check_step(&mut self, _t: f64, q: &[f64], v: &[f64]) -> Result<(), SystemError> {
         let nr = self.n_rigid;
+        let [scratch, _] = &mut self.scratch;
         for (k, f) in self.fluids.iter().enumerate() {
-            let (e, ed) = (self.fluid_slice(k, q), self.fluid_slice(k, v));
+            let o = self.layouts[k].offset;
+            let (e, ed) = (&q[o..o + f.body.n_coords()], &v[o..o + f.body.n_coords()]);
             let (volume, reference) = (f.body.volume(e), f.body.reference_volume());
             let error = (volume / reference - 1.0).abs();
             if error.is_nan() || error > 0.01 {
                 return Err(SystemError::VolumeError { what: format!("fluid {k}"), volume, reference, limit: 0.01 });
             }
             let tank = self.mb.state(Some(f.tank), &q[..nr], &v[..nr]);
-            let mut scratch = vec![0.0; e.len()];
-            let load = f.contact.forces(&f.body, &tank_kinematics(&tank), e, ed, &mut scratch, None);
+            // The contact adds its forces into the buffer.
+            scratch.clear();
+            scratch.resize(e.len(), 0.0);
+            let load = f.contact.forces(&f.body, &tank_kinematics(&tank), e, ed, scratch, None);
             let min_edge = f.body.elements.iter().flat_map(|el| el.lengths).fold(f64::INFINITY, f64::min);
             let limit = crate::slosh::system::PENETRATION_LIMIT_FACTOR * min_edge;
             if load.max_penetration > limit {
@@ -333,6 +356,7 @@ impl MechanicalSystem for FluidVehicle {
         let me = self.mb_entries;
         self.mb.force_jacobians(t, &q[..nr], &v[..nr], &mut dq[..me], &mut dv[..me])?;
         let mut pj = std::mem::take(&mut self.point_jac);
+        let [mut base, mut fp] = std::mem::take(&mut self.scratch);
         for k in 0..self.fluids.len() {
             let lay = &self.layouts[k];
             let f = &self.fluids[k];
@@ -340,11 +364,21 @@ impl MechanicalSystem for FluidVehicle {
             let (e, ed) = (&q[lay.offset..lay.offset + n], &v[lay.offset..lay.offset + n]);
             let idx = crate::slosh::system::SloshSystem::element_index;
             // Fluid–fluid: element Jacobians.
-            crate::slosh::system::subtract_element_jacobians(&f.body, &lay.element_blocks, e, ed, dq, dv)?;
+            crate::slosh::system::subtract_element_jacobians(
+                &f.body,
+                &lay.element_blocks,
+                e,
+                ed,
+                dq,
+                dv,
+                &mut self.jacobians,
+            )?;
             // Contact: fluid–fluid point Jacobians and the exact tank rows.
             let tank = self.mb.state(Some(f.tank), &q[..nr], &v[..nr]);
-            let mut scratch = vec![0.0; n];
-            f.contact.forces(&f.body, &tank_kinematics(&tank), e, ed, &mut scratch, Some(&mut pj));
+            // The contact passes add their forces into `base` and `fp`: zero them first.
+            base.clear();
+            base.resize(n, 0.0);
+            f.contact.forces(&f.body, &tank_kinematics(&tank), e, ed, &mut base, Some(&mut pj));
             let et2 = crate::mbs::rotation::e_matrix(&tank.params).transpose() * 2.0;
             for p in &pj {
                 let pt = &f.contact.points[p.point];
@@ -387,7 +421,7 @@ impl MechanicalSystem for FluidVehicle {
             }
             // Tank columns: forward differences of the contact pass.
             let t0 = 7 * f.tank.0;
-            let mut base = vec![0.0; n];
+            base.fill(0.0);
             let gen0 = self.contact_pass(k, &tank, e, ed, &mut base);
             let mut qt = [0.0; 7];
             let mut vt = [0.0; 7];
@@ -404,7 +438,8 @@ impl MechanicalSystem for FluidVehicle {
                     vp[c - 7] += h;
                 }
                 let st = BodyState::from_coordinates(&qp, &vp);
-                let mut fp = vec![0.0; n];
+                fp.clear();
+                fp.resize(n, 0.0);
                 let load_gen = self.contact_pass(k, &st, e, ed, &mut fp);
                 let (target, col) = if c < 7 { (&mut *dq, c) } else { (&mut *dv, c - 7) };
                 for r in 0..n {
@@ -428,6 +463,7 @@ impl MechanicalSystem for FluidVehicle {
             }
         }
         self.point_jac = pj;
+        self.scratch = [base, fp];
         Ok(())
     }
 

@@ -318,6 +318,21 @@ pub struct WheelRailContact {
     pub settings: ContactSettings,
     previous: Vec<[f64; 4]>,
     last_station: Option<f64>,
+    /// Reusable buffers of the search (no allocation per call once sized).
+    scratch: SearchScratch,
+}
+
+/// Buffers of [`WheelRailContact`]'s contact search, reused between calls.
+#[derive(Debug, Clone, Default)]
+struct SearchScratch {
+    /// Scan gap and parameters at each scan point.
+    scan: Vec<(f64, [f64; 4])>,
+    /// Scan seeds `(gap, q, u_lo, u_hi)`.
+    seeds: Vec<(f64, [f64; 4], f64, f64)>,
+    /// Geometry of the latest search.
+    geometry: Vec<ContactGeometry>,
+    /// Loaded points of the latest [`WheelRailContact::evaluate_cached`].
+    points: Vec<ContactPoint>,
 }
 
 impl WheelRailContact {
@@ -335,6 +350,7 @@ impl WheelRailContact {
             settings: ContactSettings::default(),
             previous: Vec::new(),
             last_station: None,
+            scratch: SearchScratch::default(),
         }
     }
 
@@ -506,21 +522,28 @@ impl WheelRailContact {
         (p.z - self.rail.profile.z(v), [s0 + p.x, v, u, th])
     }
 
-    /// Seeds `(gap, q, u_lo, u_hi)` at the local minima of the scan gap.
-    fn scan(&self, pose: &WheelPose, s0: f64) -> Vec<(f64, [f64; 4], f64, f64)> {
+    /// Seeds `(gap, q, u_lo, u_hi)` at the local minima of the scan gap, into `seeds`
+    /// (`vals` is a buffer for the scan).
+    fn scan(
+        &self,
+        pose: &WheelPose,
+        s0: f64,
+        vals: &mut Vec<(f64, [f64; 4])>,
+        seeds: &mut Vec<(f64, [f64; 4], f64, f64)>,
+    ) {
         let (lo, hi) = self.wheel.profile.y_range();
         let n = self.settings.scan_points.max(8);
-        let us: Vec<f64> = (0..n).map(|i| lo + (hi - lo) * i as f64 / (n - 1) as f64).collect();
+        let u = |i: usize| lo + (hi - lo) * i as f64 / (n - 1) as f64;
         let fd = self.rail.frame_derivs(s0);
-        let vals: Vec<(f64, [f64; 4])> = us.iter().map(|&u| self.scan_gap(pose, s0, &fd, u)).collect();
-        let mut seeds = Vec::new();
+        vals.clear();
+        vals.extend((0..n).map(|i| self.scan_gap(pose, s0, &fd, u(i))));
+        seeds.clear();
         for i in 1..n - 1 {
             let g = vals[i].0;
             if g.is_finite() && g <= vals[i - 1].0 && g < vals[i + 1].0 && g < self.settings.scan_gap_limit {
-                seeds.push((g, vals[i].1, us[i - 1], us[i + 1]));
+                seeds.push((g, vals[i].1, u(i - 1), u(i + 1)));
             }
         }
-        seeds
     }
 
     /// Golden-section refinement of the scan gap on `[a, b]` (fallback).
@@ -559,17 +582,25 @@ impl WheelRailContact {
     /// below [`ContactSettings::scan_gap_limit`]), including separated ones (negative
     /// penetration). Updates the warm-start state.
     pub fn find_geometry(&mut self, pose: &WheelPose) -> Result<Vec<ContactGeometry>, ContactError> {
+        let mut out = Vec::new();
+        self.find_geometry_into(pose, &mut out)?;
+        Ok(out)
+    }
+
+    /// [`Self::find_geometry`] into `out` (cleared first), allocating nothing once the
+    /// buffers have grown.
+    fn find_geometry_into(&mut self, pose: &WheelPose, out: &mut Vec<ContactGeometry>) -> Result<(), ContactError> {
+        out.clear();
         if !(pose.position.iter().all(|x| x.is_finite()) && pose.rotation.iter().all(|x| x.is_finite())) {
             return Err(ContactError::InvalidInput("non-finite wheel pose".into()));
         }
         let s0 = self.rail.station(&pose.position, self.last_station)?;
         self.last_station = Some(s0);
-        let mut out: Vec<ContactGeometry> = Vec::new();
         // Warm start only.
         if !self.settings.always_scan && !self.previous.is_empty() {
             let mut ok = true;
-            for q0 in self.previous.clone() {
-                match self.newton(pose, q0) {
+            for k in 0..self.previous.len() {
+                match self.newton(pose, self.previous[k]) {
                     Ok(q) if self.in_domain(&q) => out.push(self.geometry_at(pose, q, ContactMethod::Newton)),
                     _ => {
                         ok = false;
@@ -578,13 +609,16 @@ impl WheelRailContact {
                 }
             }
             if ok {
-                let out = self.dedup(out);
-                self.previous = out.iter().map(|g| g.params).collect();
-                return Ok(out);
+                self.dedup(out);
+                self.previous.clear();
+                self.previous.extend(out.iter().map(|g| g.params));
+                return Ok(());
             }
             out.clear();
         }
-        for (_, seed, ulo, uhi) in self.scan(pose, s0) {
+        let (mut vals, mut seeds) = (std::mem::take(&mut self.scratch.scan), std::mem::take(&mut self.scratch.seeds));
+        self.scan(pose, s0, &mut vals, &mut seeds);
+        for &(_, seed, ulo, uhi) in &seeds {
             // Prefer a previous solution close to this seed as the starting guess.
             let start = self.previous.iter().find(|p| (p[2] - seed[2]).abs() < 2e-3).copied().unwrap_or(seed);
             let solved =
@@ -609,35 +643,61 @@ impl WheelRailContact {
             };
             out.push(g);
         }
-        let out = self.dedup(out);
-        self.previous = out.iter().map(|g| g.params).collect();
-        Ok(out)
+        (self.scratch.scan, self.scratch.seeds) = (vals, seeds);
+        self.dedup(out);
+        self.previous.clear();
+        self.previous.extend(out.iter().map(|g| g.params));
+        Ok(())
     }
 
-    fn dedup(&self, mut v: Vec<ContactGeometry>) -> Vec<ContactGeometry> {
+    /// Keeps the deepest of points closer than the merge distance, then orders by `u`
+    /// (in place; stable sorts, which do not allocate for the few points of a wheel).
+    fn dedup(&self, v: &mut Vec<ContactGeometry>) {
         v.sort_by(|a, b| b.penetration.total_cmp(&a.penetration));
-        let mut out: Vec<ContactGeometry> = Vec::new();
-        for g in v {
-            let dup = out.iter().any(|o| {
+        let mut kept = 0;
+        for i in 0..v.len() {
+            let g = v[i];
+            let dup = v[..kept].iter().any(|o| {
                 (o.params[1] - g.params[1]).abs() < self.settings.merge_distance
                     && (o.params[2] - g.params[2]).abs() < self.settings.merge_distance
             });
             if !dup {
-                out.push(g);
+                v[kept] = g;
+                kept += 1;
             }
         }
-        out.sort_by(|a, b| a.params[2].total_cmp(&b.params[2]));
-        out
+        v.truncate(kept);
+        v.sort_by(|a, b| a.params[2].total_cmp(&b.params[2]));
     }
 
     /// Contact points in contact (`δ > 0`) with normal and creep forces.
     pub fn evaluate(&mut self, pose: &WheelPose) -> Result<Vec<ContactPoint>, ContactError> {
-        let geoms = self.find_geometry(pose)?;
+        self.evaluate_cached(pose).map(<[ContactPoint]>::to_vec)
+    }
+
+    /// [`Self::evaluate`] into a buffer of the contact, allocating nothing once the
+    /// buffers have grown; the points stay valid until the next call.
+    pub fn evaluate_cached(&mut self, pose: &WheelPose) -> Result<&[ContactPoint], ContactError> {
+        let (mut geoms, mut out) =
+            (std::mem::take(&mut self.scratch.geometry), std::mem::take(&mut self.scratch.points));
+        let result =
+            self.find_geometry_into(pose, &mut geoms).and_then(|()| self.loaded_points(pose, &geoms, &mut out));
+        (self.scratch.geometry, self.scratch.points) = (geoms, out);
+        result.map(|()| self.scratch.points.as_slice())
+    }
+
+    /// The geometries in contact (`δ > 0`) with their normal and creep forces, into `out`.
+    fn loaded_points(
+        &self,
+        pose: &WheelPose,
+        geoms: &[ContactGeometry],
+        out: &mut Vec<ContactPoint>,
+    ) -> Result<(), ContactError> {
+        out.clear();
         let e_star = combined_modulus(&self.wheel_material, &self.rail_material);
         let g_mod = 2.0 / (1.0 / self.wheel_material.shear_modulus() + 1.0 / self.rail_material.shear_modulus());
         let nu = 0.5 * (self.wheel_material.poisson + self.rail_material.poisson);
-        let mut out = Vec::new();
-        for g in geoms.into_iter().filter(|g| g.penetration > 0.0) {
+        for &g in geoms.iter().filter(|g| g.penetration > 0.0) {
             let kmin = self.settings.min_relative_curvature;
             let hertz = HertzConstants::new(g.curvature_x.max(kmin), g.curvature_y.max(kmin), e_star)?;
             let p = 0.5 * (g.point_rail + g.point_wheel);
@@ -664,7 +724,7 @@ impl WheelRailContact {
                 creep,
             });
         }
-        Ok(out)
+        Ok(())
     }
 }
 
