@@ -9,7 +9,7 @@ use ancf_core::{FluidBody, QuadratureOptions, Rheology};
 use nalgebra::{Matrix3, Vector3};
 use rail_mbs::integrator::{
     AdaptiveParams, Checkpoint, CheckpointFile, FailureCause, Hht, HhtParams, IntegratorError, Journal,
-    MechanicalSystem, SparsityPattern, StepControl, SystemError, read_journal,
+    MechanicalSystem, Predictor, SparsityPattern, StepControl, SystemError, read_journal,
 };
 use rail_mbs::mbs::rotation::axis_angle;
 use rail_mbs::mbs::{JointKind, Multibody, RigidBody};
@@ -113,12 +113,31 @@ fn constrained_multibody_run_resumed_from_a_checkpoint_is_bitwise_identical() {
     for step_control in
         [StepControl::Fixed, StepControl::Adaptive(AdaptiveParams { h_min: 1e-8, ..Default::default() })]
     {
-        let params = HhtParams { alpha: -0.1, rel_tol: 1e-8, max_iterations: 20, step_control, ..Default::default() };
-        let (mb, q0, v0) = pendulum();
-        let hht = Hht::new(mb, 0.0, q0, v0, params).unwrap();
-        let ck = check_resume(hht, || pendulum().0, params, 37, 120, 5e-3);
-        assert!(!ck.lambda.is_empty());
+        for predictor in [Predictor::Hold, Predictor::Extrapolate] {
+            let params = HhtParams {
+                alpha: -0.1,
+                rel_tol: 1e-8,
+                max_iterations: 20,
+                step_control,
+                predictor,
+                ..Default::default()
+            };
+            let (mb, q0, v0) = pendulum();
+            let hht = Hht::new(mb, 0.0, q0, v0, params).unwrap();
+            let ck = check_resume(hht, || pendulum().0, params, 37, 120, 5e-3);
+            assert!(!ck.lambda.is_empty());
+            assert!(ck.h_prev > 0.0 && ck.a_prev != ck.a, "the checkpoint carries the predictor's history");
+        }
     }
+}
+
+#[test]
+fn extrapolating_slosh_run_resumed_from_a_checkpoint_is_bitwise_identical() {
+    let params = HhtParams { predictor: Predictor::Extrapolate, ..slosh_params() };
+    let sys = slosh_system();
+    let (q0, v0) = sys.initial_state(0.0);
+    let hht = Hht::new(sys, 0.0, q0, v0, params).unwrap();
+    check_resume(hht, slosh_system, params, 12, 40, 0.008);
 }
 
 #[test]

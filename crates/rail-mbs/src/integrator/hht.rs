@@ -4,7 +4,7 @@ use std::time::Instant;
 
 use super::error::{IntegratorError, KktIndex, Quantity, SystemError};
 use super::linear::{KktSolver, LinearFailure};
-use super::params::{HhtParams, JacobianPolicy, StepControl};
+use super::params::{HhtParams, JacobianPolicy, Predictor, StepControl};
 use super::stats::Stats;
 use super::system::{MechanicalSystem, SparsityPattern};
 
@@ -81,6 +81,11 @@ pub struct Hht<S: MechanicalSystem> {
     v: Vec<f64>,
     a: Vec<f64>,
     lambda: Vec<f64>,
+    /// Accelerations and multipliers at t_{n−1} and the step h_n = t_n − t_{n−1}
+    /// (0: none, the predictor holds), for [`Predictor::Extrapolate`].
+    a_prev: Vec<f64>,
+    lam_prev: Vec<f64>,
+    h_prev: f64,
     /// `Q_n + C_q,nᵀ λ_n`, needed by the α term.
     f_old: Vec<f64>,
     f_old_valid: bool,
@@ -231,6 +236,9 @@ impl<S: MechanicalSystem> Hht<S> {
             v: v0,
             a: vec![0.0; n],
             lambda: vec![0.0; m],
+            a_prev: vec![0.0; n],
+            lam_prev: vec![0.0; m],
+            h_prev: 0.0,
             f_old: vec![0.0; n],
             f_old_valid: false,
             q_it: vec![0.0; n],
@@ -357,6 +365,7 @@ impl<S: MechanicalSystem> Hht<S> {
         self.jac_valid = false;
         self.factor_h = None;
         self.easy_count = 0;
+        self.h_prev = 0.0;
         let start = Instant::now();
         let result = self.initial_acceleration();
         self.stats.time_total += start.elapsed();
@@ -696,9 +705,18 @@ impl<S: MechanicalSystem> Hht<S> {
         for k in 0..m {
             self.w_l[k] = 1.0 / (p.rel_tol * self.lambda[k].abs() + p.abs_tol_lambda);
         }
-        // Predictor (Chrono with step control): a = a_n, λ = λ_n.
+        // Predictor: a = a_n, λ = λ_n (Chrono), or extrapolated from t_{n−1}.
         self.a_it.copy_from_slice(&self.a);
         self.lam_it.copy_from_slice(&self.lambda);
+        if p.predictor == Predictor::Extrapolate && self.h_prev > 0.0 {
+            let r = h / self.h_prev;
+            for ((x, a), a0) in self.a_it.iter_mut().zip(&self.a).zip(&self.a_prev) {
+                *x += r * (a - a0);
+            }
+            for ((x, l), l0) in self.lam_it.iter_mut().zip(&self.lambda).zip(&self.lam_prev) {
+                *x += r * (l - l0);
+            }
+        }
         self.stats.time_assembly += tic.elapsed();
 
         let mut refreshed = false;
@@ -861,8 +879,12 @@ impl<S: MechanicalSystem> Hht<S> {
         }
         std::mem::swap(&mut self.q, &mut self.q_it);
         std::mem::swap(&mut self.v, &mut self.v_it);
-        std::mem::swap(&mut self.a, &mut self.a_it);
-        std::mem::swap(&mut self.lambda, &mut self.lam_it);
+        // a_n, λ_n become the previous values (the iterates are overwritten next step)
+        std::mem::swap(&mut self.a_prev, &mut self.a_it);
+        std::mem::swap(&mut self.a, &mut self.a_prev);
+        std::mem::swap(&mut self.lam_prev, &mut self.lam_it);
+        std::mem::swap(&mut self.lambda, &mut self.lam_prev);
+        self.h_prev = h;
         self.t += h;
         self.f_old_valid = false;
         Ok(Outcome::Converged { iterations })

@@ -141,6 +141,6 @@ pub use error::{FailureCause, IntegratorError, KktIndex, Quantity, SystemError};
 pub use hht::{Checkpoint, Hht, StateRef, StepInfo};
 pub use iterative::{IterativeParams, LinearSolverKind};
 pub use journal::{CheckpointFile, Journal, read_journal};
-pub use params::{AdaptiveParams, HhtParams, JacobianPolicy, StepControl};
+pub use params::{AdaptiveParams, HhtParams, JacobianPolicy, Predictor, StepControl};
 pub use stats::Stats;
 pub use system::{MechanicalSystem, SparsityPattern};

@@ -20,6 +20,19 @@ pub enum JacobianPolicy {
     Automatic,
 }
 
+/// Initial iterate of Newton's method at each step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Predictor {
+    /// `a_{n+1} = a_n`, `λ_{n+1} = λ_n` (Chrono's choice).
+    #[default]
+    Hold,
+    /// Linear extrapolation from the last two accepted steps,
+    /// `a_{n+1} = a_n + (h/h_n)(a_n − a_{n−1})` and likewise `λ`: the first correction is
+    /// O(h²) instead of O(h) where the motion is smooth. The first step, and the first
+    /// after [`Hht::reinitialize`](super::Hht::reinitialize), hold.
+    Extrapolate,
+}
+
 /// Parameters of adaptive step control (Newton-failure driven, as in Chrono).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AdaptiveParams {
@@ -75,6 +88,8 @@ pub struct HhtParams {
     /// Relative residual tolerance `‖b − A x‖∞ ≤ tol (‖A‖_max ‖x‖∞ + ‖b‖∞)` checked
     /// after each linear solve. Default 1e-9.
     pub linear_residual_tol: f64,
+    /// Initial Newton iterate of each step. Default [`Predictor::Hold`].
+    pub predictor: Predictor,
 }
 
 impl Default for HhtParams {
@@ -89,6 +104,7 @@ impl Default for HhtParams {
             refresh_rate: 0.2,
             step_control: StepControl::Fixed,
             linear_residual_tol: 1e-9,
+            predictor: Predictor::Hold,
         }
     }
 }

@@ -1,7 +1,8 @@
 //! Checkpoint and restart of [`Hht`] with bitwise-identical continuation.
 //!
 //! A [`Checkpoint`] holds everything that determines the following steps: the state
-//! `(t, q, v, a, λ)`, the step-size controller (`h_current`, count of easy steps),
+//! `(t, q, v, a, λ)`, the previous step's `a`, `λ` and `h` (for the extrapolating
+//! predictor), the step-size controller (`h_current`, count of easy steps),
 //! the Jacobian-reuse state (whether stored Jacobians are valid, their values, and the
 //! step size of the current factorization) and the statistics. Restoring re-assembles
 //! the KKT matrix from the stored Jacobian values with the same coefficients and
@@ -21,7 +22,7 @@ use super::{Hht, IntegratorError, MechanicalSystem, Stats, linear_error};
 use crate::integrator::params::HhtParams;
 
 const MAGIC: &[u8; 8] = b"RSLHHTCK";
-const VERSION: u32 = 1;
+const VERSION: u32 = 2;
 
 /// Complete integrator state at an accepted step (see the module docs).
 #[derive(Debug, Clone, PartialEq)]
@@ -36,6 +37,12 @@ pub struct Checkpoint {
     pub a: Vec<f64>,
     /// Lagrange multipliers.
     pub lambda: Vec<f64>,
+    /// Accelerations at the previous accepted step (for [`Predictor::Extrapolate`](crate::integrator::Predictor::Extrapolate)).
+    pub a_prev: Vec<f64>,
+    /// Lagrange multipliers at the previous accepted step.
+    pub lambda_prev: Vec<f64>,
+    /// Length of the last accepted step, s (0: none; the predictor then holds).
+    pub h_prev: f64,
     /// Step-size controller: current step (adaptive mode; +inf before the first step).
     pub h_current: f64,
     /// Step-size controller: consecutive easy steps.
@@ -135,6 +142,9 @@ impl Checkpoint {
         for x in [&self.q, &self.v, &self.a, &self.lambda] {
             w.vec(x);
         }
+        w.vec(&self.a_prev);
+        w.vec(&self.lambda_prev);
+        w.f64(self.h_prev);
         w.f64(self.h_current);
         w.u64(self.easy_count as u64);
         w.0.push(u8::from(self.jac_valid));
@@ -170,14 +180,20 @@ impl Checkpoint {
             return Err(bad("not a railslosh HHT checkpoint (bad magic)"));
         }
         let version = u32::from_le_bytes(r.take(4, "version")?.try_into().expect("4 bytes"));
-        if version != VERSION {
-            return Err(bad(format!("format version {version}, this build reads {VERSION}")));
+        if version != VERSION && version != 1 {
+            return Err(bad(format!("format version {version}, this build reads 1 and {VERSION}")));
         }
         let t = r.f64("t")?;
         let q = r.vec("q")?;
         let v = r.vec("v")?;
         let a = r.vec("a")?;
         let lambda = r.vec("lambda")?;
+        // version 1 had no predictor history: the resumed run holds at its first step
+        let (a_prev, lambda_prev, h_prev) = if version >= 2 {
+            (r.vec("a_prev")?, r.vec("lambda_prev")?, r.f64("h_prev")?)
+        } else {
+            (vec![0.0; a.len()], vec![0.0; lambda.len()], 0.0)
+        };
         let h_current = r.f64("h_current")?;
         let easy_count = r.usize("easy_count")?;
         let jac_valid = r.flag("jac_valid")?;
@@ -204,8 +220,11 @@ impl Checkpoint {
             return Err(bad(format!("{} trailing bytes", bytes.len() - r.pos)));
         }
         let n = q.len();
-        if v.len() != n || a.len() != n {
-            return Err(bad(format!("q, v, a have lengths {n}, {}, {}", v.len(), a.len())));
+        if v.len() != n || a.len() != n || a_prev.len() != n {
+            return Err(bad(format!("q, v, a, a_prev have lengths {n}, {}, {}, {}", v.len(), a.len(), a_prev.len())));
+        }
+        if lambda_prev.len() != lambda.len() {
+            return Err(bad("lambda and lambda_prev have different lengths"));
         }
         if mass_jac.len() != dq.len() || dv.len() != dq.len() {
             return Err(bad("mass_jac, dq, dv have different lengths"));
@@ -216,6 +235,9 @@ impl Checkpoint {
             v,
             a,
             lambda,
+            a_prev,
+            lambda_prev,
+            h_prev,
             h_current,
             easy_count,
             jac_valid,
@@ -239,6 +261,9 @@ impl<S: MechanicalSystem> Hht<S> {
             v: self.v.clone(),
             a: self.a.clone(),
             lambda: self.lambda.clone(),
+            a_prev: self.a_prev.clone(),
+            lambda_prev: self.lam_prev.clone(),
+            h_prev: self.h_prev,
             h_current: self.h_current,
             easy_count: self.easy_count,
             jac_valid: self.jac_valid,
@@ -264,6 +289,8 @@ impl<S: MechanicalSystem> Hht<S> {
         let sizes = [
             ("a", c.a.len(), hht.n),
             ("lambda", c.lambda.len(), hht.m),
+            ("a_prev", c.a_prev.len(), hht.n),
+            ("lambda_prev", c.lambda_prev.len(), hht.m),
             ("mass_jac", c.mass_jac.len(), nd),
             ("dq", c.dq.len(), nd),
             ("dv", c.dv.len(), nd),
@@ -275,6 +302,8 @@ impl<S: MechanicalSystem> Hht<S> {
         let finite = |x: &[f64]| x.iter().all(|v| v.is_finite());
         if !(finite(&c.a)
             && finite(&c.lambda)
+            && finite(&c.a_prev)
+            && finite(&c.lambda_prev)
             && finite(&c.mass_jac)
             && finite(&c.dq)
             && finite(&c.dv)
@@ -282,11 +311,17 @@ impl<S: MechanicalSystem> Hht<S> {
         {
             return Err(bad("non-finite accelerations, multipliers or Jacobian values"));
         }
+        if !(c.h_prev.is_finite() && c.h_prev >= 0.0) {
+            return Err(bad(format!("previous step h_prev = {}", c.h_prev)));
+        }
         if c.h_current.is_nan() || c.h_current <= 0.0 || c.factor_h.is_some_and(|h| !(h.is_finite() && h > 0.0)) {
             return Err(bad(format!("step sizes h_current = {}, factor_h = {:?}", c.h_current, c.factor_h)));
         }
         hht.a.copy_from_slice(&c.a);
         hht.lambda.copy_from_slice(&c.lambda);
+        hht.a_prev.copy_from_slice(&c.a_prev);
+        hht.lam_prev.copy_from_slice(&c.lambda_prev);
+        hht.h_prev = c.h_prev;
         hht.h_current = c.h_current;
         hht.easy_count = c.easy_count;
         hht.mass_jac.copy_from_slice(&c.mass_jac);
