@@ -289,23 +289,28 @@ fn ecp_braking_oils(quick: bool) -> Result<Vec<Record>> {
         let (pl, ph) = (peak_abs(&light), peak_abs(&heavy));
         let t_end = r[k].train.t.last().copied().unwrap_or(0.0);
         let (ol, oh) = (oscillation(&light, 0.5 * t_end, t_end), oscillation(&heavy, 0.5 * t_end, t_end));
-        out.push(if quick {
+        if quick && k == 0 {
             // Coarse CI mesh: only the ordering is checked.
-            Record::less_than(
+            out.push(Record::less_than(
                 c,
                 format!("{label}: peak coupler force heavy/light ({ph:.0} N vs {pl:.0} N), quick mesh"),
                 ph / pl,
                 1.0,
-            )
-        } else {
-            Record::abs(
+            ));
+        } else if !quick {
+            out.push(Record::abs(
                 c,
                 format!("{label}: peak coupler force, 1 - heavy/light ({ph:.0} N vs {pl:.0} N); paper ~30 %"),
                 1.0 - ph / pl,
                 0.30,
                 0.15,
-            )
-        });
+            ));
+        }
+        // No quick-mesh peak check with the brake spread: there the light crude's peak is a
+        // single spike on top of the brake-difference force (which is larger for the denser
+        // heavy crude), and on the coarse mesh it moved by 13 % (4385 -> 3829 N) when only
+        // the Newton predictor changed, within the Newton tolerance, turning heavy/light from
+        // 0.90 into 1.03. The oscillation check below is the robust quick-mesh ordering.
         out.push(Record::less_than(
             c,
             format!(
