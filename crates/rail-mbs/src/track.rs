@@ -261,6 +261,12 @@ impl Track {
         Self::with_options(points, Self::STANDARD_GAUGE, Self::DEFAULT_CANT_BASE, Vector3::zeros(), 0.0)
     }
 
+    /// A straight, level track of `length` m from the global origin along `+X` (tangent
+    /// track: no curvature, super-elevation, grade or rail cant).
+    pub fn straight(length: f64) -> Result<Self, TrackError> {
+        Self::new(vec![TrackPoint::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0), TrackPoint::new(length, 0.0, 0.0, 0.0, 0.0, 0.0)])
+    }
+
     /// Builds a track with a given gauge and cant base (both m), start point and initial
     /// heading (rad, from `+X` towards `+Y`).
     pub fn with_options(

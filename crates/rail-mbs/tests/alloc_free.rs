@@ -16,7 +16,7 @@ use std::cell::Cell;
 use std::sync::Arc;
 
 use rail_mbs::integrator::{Hht, KktIndex, MechanicalSystem, SparsityPattern, Stats, SystemError};
-use rail_mbs::track::{Track, TrackPoint};
+use rail_mbs::track::Track;
 use rail_mbs::vehicle::studies::Oil;
 use rail_mbs::vehicle::{FluidCargo, FluidVehicle, TankCarParams, TrainScenario, build_fluid_train, build_train};
 
@@ -220,13 +220,7 @@ fn measure<S: MechanicalSystem + Send>(
 }
 
 fn tangent() -> Arc<Track> {
-    Arc::new(
-        Track::new(vec![
-            TrackPoint::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
-            TrackPoint::new(3000.0, 0.0, 0.0, 0.0, 0.0, 0.0),
-        ])
-        .expect("track"),
-    )
+    Arc::new(Track::straight(3000.0).expect("track"))
 }
 
 fn report(name: &str, steps: &[StepCount]) {

@@ -4,17 +4,11 @@
 use std::sync::Arc;
 
 use rail_mbs::mbs::Table;
-use rail_mbs::track::{Track, TrackPoint};
+use rail_mbs::track::Track;
 use rail_mbs::vehicle::{BrakeScope, TankCarParams, TrainScenario, build_train, run_train, validate};
 
 fn tangent() -> Arc<Track> {
-    Arc::new(
-        Track::new(vec![
-            TrackPoint::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
-            TrackPoint::new(3000.0, 0.0, 0.0, 0.0, 0.0, 0.0),
-        ])
-        .unwrap(),
-    )
+    Arc::new(Track::straight(3000.0).unwrap())
 }
 
 #[test]

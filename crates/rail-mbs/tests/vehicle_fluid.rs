@@ -253,7 +253,7 @@ fn unknowns_are_described_by_body_and_fluid_node() {
 /// Final state bits of a few steps of the studies' tank car (light crude, 6×4×2 mesh)
 /// inside a rayon pool of `threads` workers.
 fn fluid_car_in_pool(threads: usize) -> Vec<u64> {
-    use rail_mbs::track::{Track, TrackPoint};
+    use rail_mbs::track::Track;
     use rail_mbs::vehicle::studies::Oil;
     use rail_mbs::vehicle::{FluidCargo, TankCarParams, TrainScenario, build_fluid_train};
     use std::sync::Arc;
@@ -263,13 +263,7 @@ fn fluid_car_in_pool(threads: usize) -> Vec<u64> {
         let depth = p.tank_radius;
         let fluid = Oil::Light.fluid(depth, depth / 2.0).unwrap();
         let cargo = FluidCargo::new(fluid, [6, 4, 2], 0.5, vec![]);
-        let track = Arc::new(
-            Track::new(vec![
-                TrackPoint::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
-                TrackPoint::new(3000.0, 0.0, 0.0, 0.0, 0.0, 0.0),
-            ])
-            .unwrap(),
-        );
+        let track = Arc::new(Track::straight(3000.0).unwrap());
         let sc = TrainScenario::single(p, track, 300.0, 10.0, 1.0);
         let (sys, _, _) = build_fluid_train(&sc, &cargo).unwrap();
         let (q0, v0) = sys.initial_coordinates();

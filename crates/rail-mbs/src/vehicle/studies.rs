@@ -141,9 +141,7 @@ pub fn brake_torque(p: &TankCarParams, mass: f64, v0: f64, v1: f64, duration: f6
 }
 
 fn tangent() -> Result<Arc<Track>> {
-    Track::new(vec![TrackPoint::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0), TrackPoint::new(4000.0, 0.0, 0.0, 0.0, 0.0, 0.0)])
-        .map(Arc::new)
-        .map_err(|e| invalid("track", e, "valid"))
+    Track::straight(4000.0).map(Arc::new).map_err(|e| invalid("track", e, "valid"))
 }
 
 fn cargo(oil: Oil, counts: [usize; 3], bulkheads: bool, p: &TankCarParams) -> Result<FluidCargo> {

@@ -47,11 +47,7 @@ fn run(sc: &TrainScenario) -> Result<TrainRecord> {
 }
 
 fn tangent_track() -> Result<Arc<Track>> {
-    let t = Track::new(vec![
-        TrackPoint::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
-        TrackPoint::new(5000.0, 0.0, 0.0, 0.0, 0.0, 0.0),
-    ])
-    .map_err(|e| invalid("track", e, "a valid track"))?;
+    let t = Track::straight(5000.0).map_err(|e| invalid("track", e, "a valid track"))?;
     Ok(Arc::new(t))
 }
 
