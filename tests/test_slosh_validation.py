@@ -18,6 +18,7 @@ from railslosh import validate
         "slosh-viscous-decay",
         "tank-frame-equivalence",
         "bulkhead-longitudinal",
+        "slosh-linear-potential-flow",
     ],
 )
 def test_quick_slosh_case_passes(case):

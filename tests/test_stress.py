@@ -37,6 +37,7 @@ def test_quick_matrix_covers_every_axis(quick_table):
         ("vehicle", "speed_kmh"),
         ("vehicle", "braking"),
         ("fluid_vehicle", "braking"),
+        ("scene", "scene"),
     ]:
         assert (kind, axis) in axes
     values = {(r["axis"], r["value"]) for r in quick_table["rows"]}
@@ -47,6 +48,8 @@ def test_quick_matrix_covers_every_axis(quick_table):
     assert ("time_step", "1e-05") in values and ("time_step", "0.01") in values
     assert ("penalty_factor", "0.01") in values and ("penalty_factor", "100.0") in values
     assert ("speed_kmh", "120.0") in values
+    # issue 16: shortened SwRI scenes, past the time at which their liquid used to leave the tank
+    assert ("scene", "swri_lane_change_40mph@1.5s") in values
 
 
 def test_quick_matrix_has_no_silent_failures(quick_table):

@@ -234,6 +234,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
         "wall_time": wall,
         "stats": dict(st),
         "error": res.get("error"),
+        "margins": res.get("margins"),
     }
     # the model the run used (run_scene records it, also on a failed run)
     summary |= {k: res[k] for k in ("fluid_model", "fluid_model_reason") if k in res}

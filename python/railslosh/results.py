@@ -66,6 +66,18 @@ VARIABLES: dict[str, tuple[tuple[str, ...], str, str, str, dict[str, str]]] = {
     "potential_energy": ((), "J", "global", "gravitational potential energy of the liquid", {}),
     "newton_iterations": ((), "1", "", "Newton iterations of the step", {}),
     "max_penetration": ((), "m", "tank", "largest wall penetration of the liquid", {}),
+    # run-time invariants (rail_mbs::invariants)
+    "stored_energy": ((), "J", "", "stored elastic energy of the liquid (penalty + contact springs)", {}),
+    "input_work": (
+        (),
+        "J",
+        "",
+        "work put into the liquid (walls; in the tank frame gravity and pseudo-forces)",
+        {},
+    ),
+    "energy_error": ((), "1", "", "energy growth (E - E0 - input work) / energy scale; <= 0 when physical", {}),
+    "min_volume_ratio": ((), "1", "", "smallest volume ratio J = det F at any quadrature point", {}),
+    "containment_gap": ((), "m", "tank", "largest gap beyond a wall of any fluid node, contact point or the centre of mass", {}),
 }
 
 _SCALARS = ("static_wheel_load", "dof", "fluid_mass", "elements")
@@ -138,6 +150,9 @@ def to_dataset(res: Mapping[str, Any], scene: Any = None) -> Any:
             attrs[k] = str(res[k])
     for k, v in (res.get("stats") or {}).items():
         attrs[f"stats_{k}"] = v
+    for k, v in (res.get("margins") or {}).items():
+        if v is not None:  # None: not measured (vehicle runs keep no energy account)
+            attrs[f"margin_{k}"] = v
     if res.get("error"):
         attrs["error"] = str(res["error"])
     attrs |= _scene_attrs(scene if scene is not None else res.get("scene"))

@@ -837,7 +837,10 @@ class SloshScene:
     of the shell, ``radius``, ``head_depth``; defaults: the crude-oil tank car) or ``"box"`` (``lower``,
     ``upper`` corners); ``bulkheads`` as in vehicle scenes (cylinder only).
     ``[fluid]``: as in vehicle scenes (``oil``, ``fill`` as a volume fraction, custom
-    fluids). ``[mesh]``: ``counts``. ``[solver]``: ``t_end`` (s), ``step`` (s), ``frame``
+    fluids). ``[mesh]``: ``counts``; ``viscous_points`` and ``penalty_points`` (Gauss points per
+    direction of the viscous stress, 3-6, and of the volumetric penalty, 2-6; default 3) and
+    ``contact_points_per_edge`` (wall-contact points per face edge, 2-6, default 3): coarse meshes
+    under violent maneuvers need 4 (docs/validation.md, "Run-time invariants"). ``[solver]``: ``t_end`` (s), ``step`` (s), ``frame``
     (``"inertial"`` or ``"tank"``), ``contact_stiffness_factor`` (wall stiffness as a multiple of the
     default penalty law, 0.1 to 1000). ``[outputs]``: ``netcdf``, ``plots``.
     ``[maneuver]``: ``type`` =
@@ -867,6 +870,12 @@ class SloshScene:
     frame: str = "inertial"
     contact_stiffness_factor: float = 1.0
     """Wall stiffness as a multiple of the default penalty law (damping ratio kept)."""
+    viscous_points: int = 3
+    """Gauss points per direction of the viscous stress (3 to 6)."""
+    penalty_points: int = 3
+    """Gauss points per direction of the volumetric penalty (2 to 6)."""
+    contact_points_per_edge: int = 3
+    """Wall-contact Gauss points per boundary-face edge (2 to 6)."""
     name: str = ""
     description: str = ""
     outputs: Outputs = field(default_factory=lambda: Outputs(vtu=False))
@@ -935,7 +944,14 @@ class SloshScene:
             k = 1000.0 * spec.density() * 9.81 * depth * max(1.0, self.peak_load_factor())
             spec = dataclasses.replace(spec, custom={**spec.custom, "bulk_penalty": k})
         fluid = spec.make_fluid(depth, depth / spec.counts[2])
-        kw: dict[str, Any] = {"t_end": self.t_end, "h": self.step, "frame": self.frame}
+        kw: dict[str, Any] = {
+            "t_end": self.t_end,
+            "h": self.step,
+            "frame": self.frame,
+            "viscous_points": self.viscous_points,
+            "penalty_points": self.penalty_points,
+            "contact_points_per_edge": self.contact_points_per_edge,
+        }
         if self.contact_stiffness_factor != 1.0:
             kw["contact_stiffness_factor"] = self.contact_stiffness_factor
         return (self.mesh(), fluid, self.tank, self.motion()), kw
@@ -1164,8 +1180,12 @@ def slosh_scene_from_dict(data: Mapping[str, Any]) -> SloshScene:
     oil, custom = _fluid_section(fl)
     fill = _number(fl.get("fill", 0.5), "fluid.fill", 0.1, 0.9, "(volume fraction)")
     ms = _table(data.get("mesh", {}), "mesh")
-    _check_keys(ms, "mesh", ("counts",))
+    _check_keys(ms, "mesh", ("counts", "viscous_points", "penalty_points", "contact_points_per_edge"))
     counts = _counts(ms.get("counts", [2, 4, 2]), "mesh.counts", ((1, 40), (1, 40), (1, 10)))
+    rules = {
+        k: _integer(ms.get(k, 3), f"mesh.{k}", lo, 6)
+        for k, lo in (("viscous_points", 3), ("penalty_points", 2), ("contact_points_per_edge", 2))
+    }
     tank = _slosh_tank(_table(data.get("tank", {}), "tank"), counts)
     spec = FluidSpec(oil=oil, fill=fill, counts=counts, bulkheads=tank.bulkheads, custom=custom)
     maneuver = _maneuver(_table(data.get("maneuver", {}), "maneuver"), t_end)
@@ -1191,6 +1211,7 @@ def slosh_scene_from_dict(data: Mapping[str, Any]) -> SloshScene:
         description=description,
         outputs=outputs,
         raw=dict(data),
+        **rules,
     )
     try:
         sc.mesh()

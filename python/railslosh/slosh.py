@@ -71,6 +71,9 @@ class Motion:
 #: Failure causes (``SimulationError.cause``) and the patterns of the Rust error messages
 #: that name them, matched in this order (the names are those of Rust's ``FailureCause``).
 FAILURE_CAUSES: tuple[tuple[str, str], ...] = (
+    ("containment", r"not contained: "),
+    ("energy_growth", r"energy balance broken"),
+    ("distorted_element", r"distorted: J ="),
     ("contact_penetration", r"penetration .* beyond its limit"),
     ("volume_error", r"volume .* deviates from its reference"),
     ("inverted_element", r"inverted: J =|inverted element|J = [-+0-9.e]+ <= 0"),
@@ -116,6 +119,9 @@ def run(
     checkpoint: str | os.PathLike[str] | None = None,
     checkpoint_every: int = 100,
     resume_from: str | os.PathLike[str] | None = None,
+    viscous_points: int = 3,
+    penalty_points: int = 3,
+    contact_points_per_edge: int = 3,
 ) -> dict:
     """Integrate the fluid in the moving tank up to `t_end` with steps of at most `h`.
 
@@ -133,6 +139,17 @@ def run(
     a boundary point penetrates a wall deeper than ``penetration_limit`` times the smallest element
     edge (``math.inf`` disables either). ``contact_stiffness_factor`` scales the wall-contact
     penalty stiffness (damping ratio kept).
+
+    Run-time invariants (``rail_mbs::invariants``), also on every accepted step: ``"containment"``
+    when a fluid node, contact point or the centre of mass lies beyond a wall by more than the same
+    penetration limit; ``"distorted_element"`` / ``"inverted_element"`` when the volume ratio
+    J = det F at any quadrature or check point falls to 0.1 / 0; ``"energy_growth"`` when the energy
+    E (kinetic, gravitational, penalty, contact springs) exceeds E0 + the work put in by more than 5 %
+    of the energy scale. The results carry ``stored_energy``, ``input_work``, ``energy_error``,
+    ``min_volume_ratio``, ``containment_gap`` per sample and the worst ``margins``.
+    ``viscous_points``, ``penalty_points`` (Gauss points per direction) and
+    ``contact_points_per_edge`` set the quadrature of the viscous stress, the penalty and the wall
+    contact.
 
     ``stream`` (a file path) writes every sample to that file as it is computed (flushed per step),
     so a run that is interrupted -- killed, out of time -- loses nothing already computed; read it
@@ -171,6 +188,9 @@ def run(
         checkpoint=None if checkpoint is None else os.fspath(checkpoint),
         checkpoint_every=checkpoint_every,
         resume_from=None if resume_from is None else os.fspath(resume_from),
+        viscous_points=viscous_points,
+        penalty_points=penalty_points,
+        contact_points_per_edge=contact_points_per_edge,
     )
     if res["error"] is not None:
         raise SimulationError(f"slosh run stopped at t = {res['t'][-1]:.4f} s: {res['error']}", res)
@@ -178,7 +198,18 @@ def run(
 
 
 _VECTORS = ("force_tank", "moment_tank", "force_global", "moment_global", "com_tank")
-_SCALARS = ("volume", "kinetic_energy", "potential_energy", "newton_iterations", "max_penetration")
+_SCALARS = (
+    "volume",
+    "kinetic_energy",
+    "potential_energy",
+    "newton_iterations",
+    "max_penetration",
+    "stored_energy",
+    "input_work",
+    "energy_error",
+    "min_volume_ratio",
+    "containment_gap",
+)
 
 
 def read_stream(path: str | os.PathLike[str]) -> dict:

@@ -65,6 +65,9 @@ _DESCRIPTIONS = {
     "under the same braking pulse",
     "tank-frame-equivalence": "same manoeuvre as tank-frame pseudo-forces and as prescribed inertial motion: "
     "same loads within 1 %",
+    "slosh-linear-potential-flow": "seed 003 rectangular tank, 0.03 g lateral pulse (linear regime): lateral load "
+    "history vs the 50-mode linear potential-flow solution, RMS difference over 0.5-4 s <= 10 % of its peak; "
+    "first-mode frequency from zero crossings vs 1.436 Hz",
     "manchester-contact-left": "Manchester contact benchmark A2.2, left wheel (S1002 on UIC60 1:40, 10 kN, shifts "
     "0-10 mm) vs CONTACT: contact position, normal force, creep forces (needs shared data)",
     "static-wheel-loads": "68-DOF tank car (36 t rigid lading) settles on tangent track: every wheel load equals "
@@ -94,8 +97,9 @@ def _python_cases() -> dict[str, Case]:
     """Cases implemented in Python (name -> (description, run(quick) -> records))."""
     from railslosh.cosim.cases import PY_CASES
     from railslosh.fmu import FMU_CASES
+    from railslosh.swri_cases import SWRI_CASES
 
-    return {name: Case(name, desc, fn) for name, (desc, fn) in {**PY_CASES, **FMU_CASES}.items()}
+    return {name: Case(name, desc, fn) for name, (desc, fn) in {**PY_CASES, **FMU_CASES, **SWRI_CASES}.items()}
 
 
 CASES.update(_python_cases())

@@ -83,6 +83,19 @@ pub struct ElementJacobian {
     pub damping: Vec<f64>,
 }
 
+/// Extremes of the volume ratio J = det F over a body ([`FluidBody::volume_ratio_range`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VolumeRatioRange {
+    /// Smallest J.
+    pub min: f64,
+    /// Element of the smallest J.
+    pub element: usize,
+    /// Its point: viscous points first, then penalty, then mass points.
+    pub point: usize,
+    /// Largest J.
+    pub max: f64,
+}
+
 /// A meshed fluid body with its precomputed reference data.
 #[derive(Debug, Clone)]
 pub struct FluidBody {
@@ -223,6 +236,29 @@ impl FluidBody {
             .zip(&self.mesh.elements)
             .map(|(el, nodes)| el.volume_current(&gather_compact_flat(e, nodes), &self.tables))
             .sum()
+    }
+
+    /// Stored energy of the volumetric penalty, Σ ∫ ½ k (J − 1)² dV₀ (J).
+    pub fn penalty_energy(&self, e: &[f64]) -> f64 {
+        self.elements
+            .iter()
+            .zip(&self.mesh.elements)
+            .map(|(el, nodes)| el.penalty_energy(&gather_compact_flat(e, nodes), &self.tables, self.fluid.bulk_penalty))
+            .sum()
+    }
+
+    /// The smallest volume ratio J = det F over every quadrature point of every element
+    /// (all three rules, see [`ElementRef::volume_ratio_range`]) and the largest.
+    pub fn volume_ratio_range(&self, e: &[f64]) -> VolumeRatioRange {
+        let mut r = VolumeRatioRange { min: f64::INFINITY, element: 0, point: 0, max: f64::NEG_INFINITY };
+        for (k, (el, nodes)) in self.elements.iter().zip(&self.mesh.elements).enumerate() {
+            let (lo, p, hi) = el.volume_ratio_range(&gather_compact_flat(e, nodes), &self.tables);
+            if lo.is_nan() || lo < r.min {
+                (r.min, r.element, r.point) = (lo, k, p);
+            }
+            r.max = r.max.max(hi);
+        }
+        r
     }
 
     /// Global index of compact coordinate `3a + i` of element `el`.
@@ -513,6 +549,49 @@ mod tests {
                 assert_eq!(fresh, reused, "penalty {penalty}");
             }
         }
+    }
+
+    /// The penalty energy is the potential of the penalty force: with no viscosity, no
+    /// bulk damping and ė = 0 the internal force is ∂U/∂e (central differences along a
+    /// direction), and U vanishes in the reference state.
+    #[test]
+    fn penalty_energy_is_the_potential_of_the_internal_force() {
+        let (mut body, states) = body_and_states(2e6);
+        body.fluid.rheology = Rheology::Newtonian { viscosity: 0.0 };
+        body.fluid.bulk_damping = 0.0;
+        assert!(body.penalty_energy(&body.reference_coordinates()) < 1e-20);
+        let n = body.n_coords();
+        for (e, v) in &states {
+            let mut f = vec![0.0; n];
+            body.internal_forces(e, &vec![0.0; n], &mut f).unwrap();
+            let h = 1e-6;
+            let at = |s: f64| body.penalty_energy(&e.iter().zip(v).map(|(x, d)| x + s * d).collect::<Vec<_>>());
+            let du = (at(h) - at(-h)) / (2.0 * h);
+            let fd: f64 = f.iter().zip(v).map(|(a, b)| a * b).sum();
+            assert!(body.penalty_energy(e) > 0.0);
+            assert!((du - fd).abs() < 1e-6 * fd.abs(), "dU = {du}, f.d = {fd}");
+        }
+    }
+
+    /// The volume ratio range: 1 in the reference state, the extremes of a uniform
+    /// stretch, and the smallest at its element when one element is squashed.
+    #[test]
+    fn volume_ratio_range_sees_stretch_and_a_squashed_element() {
+        let (body, _) = body_and_states(2e6);
+        let e0 = body.reference_coordinates();
+        let r = body.volume_ratio_range(&e0);
+        assert!((r.min - 1.0).abs() < 1e-12 && (r.max - 1.0).abs() < 1e-12, "{r:?}");
+        // x ↦ 1.2 x: positions and x-gradients scale
+        let stretched: Vec<f64> = e0.iter().enumerate().map(|(i, x)| if i % 3 == 0 { 1.2 * x } else { *x }).collect();
+        let r = body.volume_ratio_range(&stretched);
+        assert!((r.min - 1.2).abs() < 1e-12 && (r.max - 1.2).abs() < 1e-12, "{r:?}");
+        // flatten the z-gradient of one node of element 3: J drops there, first
+        let mut e = e0.clone();
+        let node = body.mesh.elements[3][6];
+        e[12 * node + 3 * 3 + 2] *= -1.0;
+        let r = body.volume_ratio_range(&e);
+        assert!(r.min < 1.0 && r.max > 1.0, "{r:?}");
+        assert!(body.mesh.elements[r.element].contains(&node), "{r:?}");
     }
 
     /// Reused element Jacobians equal freshly computed ones, state after state.

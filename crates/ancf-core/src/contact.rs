@@ -60,7 +60,7 @@ use crate::constitutive::{M3, smoothstep};
 use crate::element::scaled;
 use crate::error::{Result, check_non_negative, check_positive, invalid};
 use crate::mesh::Face;
-use crate::quadrature::gauss_legendre;
+use crate::quadrature::{gauss_legendre, gauss_lobatto};
 use crate::shape::{N_SHAPE, normalized_shape};
 use crate::tank::{TankGeometry, WallHit};
 
@@ -85,6 +85,17 @@ pub enum WallFriction {
     },
 }
 
+/// Where the contact points sit on each boundary face.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ContactPointRule {
+    /// Gauss–Legendre points: interior to the face, so nodes, edges and corners are not
+    /// checked and can pass through a wall between the points.
+    Gauss,
+    /// Gauss–Lobatto points: the face's nodes, edges and corners are contact points too
+    /// (a corner shared by faces is a point of each, with its own area weight).
+    Lobatto,
+}
+
 /// Penalty contact law.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct WallContactLaw {
@@ -94,8 +105,10 @@ pub struct WallContactLaw {
     pub damping: f64,
     /// Tangential law.
     pub friction: WallFriction,
-    /// Gauss points per face edge (points per face = this squared).
+    /// Points per face edge (points per face = this squared).
     pub points_per_edge: usize,
+    /// Where the points sit on a face (default [`ContactPointRule::Gauss`]).
+    pub point_rule: ContactPointRule,
 }
 
 impl WallContactLaw {
@@ -110,7 +123,13 @@ impl WallContactLaw {
         let k = 1000.0 * density * gravity;
         let delta_e = density * gravity * depth / k;
         let c = 2.0 * 0.1 * (k * density * depth).sqrt() / delta_e;
-        Self { stiffness: k, damping: c, friction: WallFriction::Frictionless, points_per_edge: 3 }
+        Self {
+            stiffness: k,
+            damping: c,
+            friction: WallFriction::Frictionless,
+            points_per_edge: 3,
+            point_rule: ContactPointRule::Gauss,
+        }
     }
 
     /// Validate; errors name the field.
@@ -119,6 +138,13 @@ impl WallContactLaw {
         check_non_negative("contact.damping", self.damping)?;
         if !(1..=6).contains(&self.points_per_edge) {
             return Err(invalid("contact.points_per_edge", self.points_per_edge, "an integer in [1, 6]"));
+        }
+        if self.point_rule == ContactPointRule::Lobatto && self.points_per_edge < 2 {
+            return Err(invalid(
+                "contact.points_per_edge",
+                self.points_per_edge,
+                "an integer in [2, 6] with Gauss-Lobatto points (they include both face edges)",
+            ));
         }
         match self.friction {
             WallFriction::Frictionless => Ok(()),
@@ -208,6 +234,45 @@ pub struct WallContact {
     pub points: Vec<ContactPoint>,
     /// Cull data of each boundary face, in the order of `points`.
     faces: Vec<FaceCull>,
+    /// Bulkhead sides of each mesh node (from its reference position).
+    node_sides: Vec<Vec<i8>>,
+}
+
+/// A place in the liquid checked for containment ([`WallContact::containment`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FluidSite {
+    /// A mesh node (its position coordinates).
+    Node(usize),
+    /// A contact point on the boundary ([`WallContact::points`]) of `element`.
+    ContactPoint {
+        /// Index into [`WallContact::points`].
+        point: usize,
+        /// Its element.
+        element: usize,
+    },
+    /// The liquid's centre of mass (checked against the shell only).
+    CentreOfMass,
+}
+
+impl std::fmt::Display for FluidSite {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Node(n) => write!(f, "fluid node {n}"),
+            Self::ContactPoint { point, element } => write!(f, "contact point {point} (element {element})"),
+            Self::CentreOfMass => f.write_str("liquid centre of mass"),
+        }
+    }
+}
+
+/// The deepest place of the liquid beyond its walls ([`WallContact::containment`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Breach {
+    /// Where.
+    pub site: FluidSite,
+    /// Its tank-frame position (m).
+    pub position: [f64; 3],
+    /// How far beyond the wall (ψ > 0, m).
+    pub depth: f64,
 }
 
 /// Culling mode of [`WallContact::forces_counted`] (tests and benchmarks).
@@ -273,7 +338,10 @@ impl WallContact {
     /// each point is taken from its reference position (the tank frame at t = 0).
     pub fn new(body: &FluidBody, geometry: TankGeometry, law: WallContactLaw) -> Result<Self> {
         law.validate()?;
-        let (gx, gw) = gauss_legendre(law.points_per_edge)?;
+        let (gx, gw) = match law.point_rule {
+            ContactPointRule::Gauss => gauss_legendre(law.points_per_edge)?,
+            ContactPointRule::Lobatto => gauss_lobatto(law.points_per_edge)?,
+        };
         let mut points = Vec::new();
         let mut faces = Vec::new();
         let ppe = law.points_per_edge;
@@ -333,7 +401,63 @@ impl WallContact {
             let size = pos.iter().fold(0.0f64, |m, x| m.max((x - wo).norm()));
             f.candidate = geometry.clearance([wo[0], wo[1], wo[2]], &points[f.start].sides) > CULL_GATE * size;
         }
-        Ok(Self { geometry, law, points, faces })
+        let node_sides = body.mesh.nodes.iter().map(|n| geometry.sides([n[0], n[1], n[2]])).collect();
+        Ok(Self { geometry, law, points, faces, node_sides })
+    }
+
+    /// The deepest place of the liquid beyond its walls: every mesh node, every contact
+    /// point and the centre of mass (against the shell; nodes and points also against the
+    /// bulkheads of their compartment), as the largest wall gap ψ > 0 in the tank frame.
+    /// `None`: everything is inside. Non-finite positions are reported with depth +∞.
+    pub fn containment(&self, body: &FluidBody, kin: &TankKinematics, e: &[f64]) -> Option<Breach> {
+        let at = kin.rotation.transpose();
+        let rt = Vector3::from(kin.position);
+        let mut worst: Option<Breach> = None;
+        let mut consider = |site: FluidSite, r: Vector3<f64>, sides: &[i8]| {
+            let p = at * (r - rt);
+            let p = [p[0], p[1], p[2]];
+            let mut depth = if p.iter().all(|x| x.is_finite()) { 0.0 } else { f64::INFINITY };
+            self.geometry.for_each_hit_with(p, sides, false, |h| depth = f64::max(depth, h.psi));
+            if depth > 0.0 && worst.is_none_or(|w| depth > w.depth) {
+                worst = Some(Breach { site, position: p, depth });
+            }
+        };
+        for (n, sides) in self.node_sides.iter().enumerate() {
+            let g = 12 * n;
+            consider(FluidSite::Node(n), Vector3::new(e[g], e[g + 1], e[g + 2]), sides);
+        }
+        for (k, pt) in self.points.iter().enumerate() {
+            let nodes = &body.mesh.elements[pt.element];
+            let mut r = Vector3::zeros();
+            for a in 0..N_SHAPE {
+                let g = 3 * (4 * nodes[a / 4] + a % 4);
+                r += pt.shape[a] * Vector3::new(e[g], e[g + 1], e[g + 2]);
+            }
+            consider(FluidSite::ContactPoint { point: k, element: pt.element }, r, &pt.sides);
+        }
+        consider(FluidSite::CentreOfMass, Vector3::from(body.center_of_mass(e)), &[]);
+        worst
+    }
+
+    /// Energy stored in the contact springs, Σ w ½ k_p ψ² over every contact point and
+    /// every wall it penetrates (J): the potential of the elastic part of the contact force.
+    pub fn stored_energy(&self, body: &FluidBody, kin: &TankKinematics, e: &[f64]) -> f64 {
+        let at = kin.rotation.transpose();
+        let rt = Vector3::from(kin.position);
+        let mut u = 0.0;
+        for pt in &self.points {
+            let nodes = &body.mesh.elements[pt.element];
+            let mut r = Vector3::zeros();
+            for a in 0..N_SHAPE {
+                let g = 3 * (4 * nodes[a / 4] + a % 4);
+                r += pt.shape[a] * Vector3::new(e[g], e[g + 1], e[g + 2]);
+            }
+            let p = at * (r - rt);
+            self.geometry.for_each_hit_with([p[0], p[1], p[2]], &pt.sides, false, |h| {
+                u += 0.5 * pt.weight * self.law.stiffness * h.psi * h.psi;
+            });
+        }
+        u
     }
 
     /// Position and velocity of a contact point (global).
@@ -792,7 +916,13 @@ mod tests {
             vec![Bulkhead { x: 0.01, thickness: 0.01 }],
         )
         .unwrap();
-        let law = WallContactLaw { stiffness: 1e6, damping: 2e5, friction, points_per_edge: 2 };
+        let law = WallContactLaw {
+            stiffness: 1e6,
+            damping: 2e5,
+            friction,
+            points_per_edge: 2,
+            point_rule: ContactPointRule::Gauss,
+        };
         let contact = WallContact::new(&body, geo, law).unwrap();
         let rot = *Rotation3::from_euler_angles(0.1, -0.2, 0.3).matrix();
         let kin = TankKinematics {
@@ -893,5 +1023,84 @@ mod tests {
         let c = WallContact::new(&body, geo, WallContactLaw::default_for(1000.0, 9.81, 0.3)).unwrap();
         let area: f64 = c.points.iter().map(|p| p.weight).sum();
         assert!((area - 2.0 * (0.6 * 0.4 + 0.6 * 0.3 + 0.4 * 0.3)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn lobatto_points_cover_the_area_and_hold_every_boundary_node() {
+        let mesh = box_mesh([0.0; 3], [0.6, 0.4, 0.3], [3, 2, 2]).unwrap();
+        let fluid = Fluid::new(1000.0, Rheology::Newtonian { viscosity: 1.0 }, 1e5).unwrap();
+        let body = FluidBody::new(mesh, fluid, QuadratureOptions::default()).unwrap();
+        let geo = TankGeometry::new(TankShape::Box { min: [0.0; 3], max: [0.6, 0.4, 0.5] }, vec![]).unwrap();
+        let law =
+            WallContactLaw { point_rule: ContactPointRule::Lobatto, ..WallContactLaw::default_for(1000.0, 9.81, 0.3) };
+        let c = WallContact::new(&body, geo.clone(), law).unwrap();
+        let area: f64 = c.points.iter().map(|p| p.weight).sum();
+        assert!((area - 2.0 * (0.6 * 0.4 + 0.6 * 0.3 + 0.4 * 0.3)).abs() < 1e-12);
+        // every node on the boundary is a contact point (Gauss points never are)
+        let e = body.reference_coordinates();
+        let at = |k: usize| {
+            let nodes = &body.mesh.elements[c.points[k].element];
+            (0..N_SHAPE).fold(Vector3::zeros(), |r, a| {
+                let g = 3 * (4 * nodes[a / 4] + a % 4);
+                r + c.points[k].shape[a] * Vector3::new(e[g], e[g + 1], e[g + 2])
+            })
+        };
+        let pts: Vec<Vector3<f64>> = (0..c.points.len()).map(at).collect();
+        let on_boundary =
+            |p: &[f64; 12]| (0..3).any(|d| p[d].abs() < 1e-12 || (p[d] - [0.6, 0.4, 0.3][d]).abs() < 1e-12);
+        for n in body.mesh.nodes.iter().filter(|n| on_boundary(n)) {
+            let x = Vector3::new(n[0], n[1], n[2]);
+            assert!(pts.iter().any(|p| (p - x).norm() < 1e-12), "node {x:?} is no contact point");
+        }
+        let gauss = WallContact::new(&body, geo, WallContactLaw::default_for(1000.0, 9.81, 0.3)).unwrap();
+        let corner = Vector3::zeros();
+        assert!((0..gauss.points.len()).all(|k| {
+            let nodes = &body.mesh.elements[gauss.points[k].element];
+            let r = (0..N_SHAPE).fold(Vector3::zeros(), |r, a| {
+                let g = 3 * (4 * nodes[a / 4] + a % 4);
+                r + gauss.points[k].shape[a] * Vector3::new(e[g], e[g + 1], e[g + 2])
+            });
+            (r - corner).norm() > 1e-3
+        }));
+        // one point per edge cannot hold both edges
+        let one = WallContactLaw { points_per_edge: 1, ..law };
+        assert!(one.validate().unwrap_err().to_string().contains("contact.points_per_edge"));
+    }
+
+    #[test]
+    fn containment_finds_the_deepest_site_and_stored_energy_is_the_spring_potential() {
+        let (body, c, kin, e, _) = setup(WallFriction::Frictionless);
+        // the tank is smaller than the mesh: nodes at the corners stick out by 10 mm in x
+        let b = c.containment(&body, &kin, &e).expect("the setup penetrates");
+        assert!(b.depth > 0.0 && b.depth.is_finite());
+        // no site is deeper: every node checked against the same walls
+        let at = kin.rotation.transpose();
+        for n in 0..body.mesh.n_nodes() {
+            let r = Vector3::new(e[12 * n], e[12 * n + 1], e[12 * n + 2]) - Vector3::from(kin.position);
+            let p = at * r;
+            let mut d = 0.0f64;
+            c.geometry.for_each_hit([p[0], p[1], p[2]], &c.node_sides[n], |h| d = d.max(h.psi));
+            assert!(d <= b.depth + 1e-15, "node {n} is {d} deep, deeper than {b:?}");
+        }
+        // stored energy: d/ds U(e + s δ) = −(elastic contact force)·δ, checked by central
+        // differences with the damping switched off
+        let mut law = c.law;
+        law.damping = 0.0;
+        let c0 = WallContact { law, ..c.clone() };
+        let mut rng = Rng::new(11);
+        let d: Vec<f64> = (0..e.len()).map(|_| rng.uniform() * 1e-3).collect();
+        let zero = vec![0.0; e.len()];
+        let mut f = vec![0.0; e.len()];
+        c0.forces(&body, &kin, &e, &zero, &mut f, None);
+        let s = 1e-4;
+        let plus: Vec<f64> = e.iter().zip(&d).map(|(x, y)| x + s * y).collect();
+        let minus: Vec<f64> = e.iter().zip(&d).map(|(x, y)| x - s * y).collect();
+        let du = (c0.stored_energy(&body, &kin, &plus) - c0.stored_energy(&body, &kin, &minus)) / (2.0 * s);
+        let fd: f64 = f.iter().zip(&d).map(|(x, y)| x * y).sum();
+        assert!((du + fd).abs() < 1e-6 * fd.abs().max(1e-9), "dU = {du}, -F.d = {}", -fd);
+        // a body far outside: reported, with an infinite depth for non-finite coordinates
+        let mut nan = e.clone();
+        nan[0] = f64::NAN;
+        assert_eq!(c.containment(&body, &kin, &nan).map(|b| b.depth), Some(f64::INFINITY));
     }
 }

@@ -81,9 +81,13 @@ pub struct ShapeTable {
 impl ShapeTable {
     /// Tabulate the shape functions at an `n × n × n` Gauss rule.
     pub fn gauss(n: usize) -> Result<Self> {
-        let rule = CubeRule::gauss(n)?;
+        Ok(Self::of(CubeRule::gauss(n)?))
+    }
+
+    /// Tabulate the shape functions at the points of `rule`.
+    pub fn of(rule: CubeRule) -> Self {
         let (nn, dn) = rule.points.iter().map(|p| normalized_shape(*p)).unzip();
-        Ok(Self { rule, n: nn, dn })
+        Self { rule, n: nn, dn }
     }
 
     /// Number of points.
@@ -108,6 +112,10 @@ pub struct ShapeTables {
     pub penalty: ShapeTable,
     /// Mass rule.
     pub mass: ShapeTable,
+    /// Check points of the volume ratio ([`ElementRef::volume_ratio_range`]): the 3×3×3
+    /// Gauss–Lobatto points (corners, edge and face centres, centre), apart from the
+    /// force and mass rules, so that a field folding between those points is seen.
+    pub check: ShapeTable,
 }
 
 impl ShapeTables {
@@ -119,6 +127,7 @@ impl ShapeTables {
             viscous: ShapeTable::gauss(options.viscous)?,
             penalty: ShapeTable::gauss(options.penalty)?,
             mass: ShapeTable::gauss(options.mass)?,
+            check: ShapeTable::of(CubeRule::lobatto(3)?),
         })
     }
 }
@@ -147,6 +156,10 @@ pub struct ElementRef {
     pub mass: Vec<RefPoint>,
     /// Reference volume V₀ (mass rule).
     pub volume: f64,
+    /// Points of the check table ([`ShapeTables::check`]) with their index there, where
+    /// the reference map is regular (det Ĵ₀ above 5 % of the element's mean; a corner of a
+    /// nearly collapsed reference map is left out).
+    pub check: Vec<(usize, RefPoint)>,
 }
 
 /// Element coordinates in compact form: `e[a]` is the 3-vector of compact column `a`.
@@ -199,7 +212,21 @@ impl ElementRef {
         let penalty = points(&tables.penalty)?;
         let mass = points(&tables.mass)?;
         let volume = mass.iter().map(|p| p.wdet).sum();
-        Ok(Self { lengths, scale, viscous, penalty, mass, volume })
+        let check = tables
+            .check
+            .dn
+            .iter()
+            .enumerate()
+            .filter_map(|(p, dn)| {
+                let j0 = grad_xi(&ehat, dn);
+                let det = j0.determinant();
+                // a corner where the reference map nearly collapses (det below 5 % of the
+                // element's mean) would turn round-off into arbitrary volume ratios
+                (det > 0.05 * volume / 8.0 && det.is_finite())
+                    .then(|| (p, RefPoint { jinv: j0.try_inverse().expect("det > 0"), wdet: det }))
+            })
+            .collect();
+        Ok(Self { lengths, scale, viscous, penalty, mass, volume, check })
     }
 
     /// Compact 32×32 scalar mass matrix ∫ρ N_a N_b dV₀ (row-major). The full 96×96 mass
@@ -239,6 +266,52 @@ impl ElementRef {
             .zip(&tables.viscous.dn)
             .map(|(rp, dn)| rp.wdet * (grad_xi(&ehat, dn) * rp.jinv).determinant())
             .sum()
+    }
+
+    /// Stored energy of the volumetric penalty, ∫ ½ k (J − 1)² dV₀ over the penalty rule
+    /// (the potential whose gradient is the penalty part of the internal force).
+    pub fn penalty_energy(&self, e: &Compact, tables: &ShapeTables, bulk_penalty: f64) -> f64 {
+        let ehat = scaled(e, &self.scale);
+        self.penalty
+            .iter()
+            .zip(&tables.penalty.dn)
+            .map(|(rp, dn)| {
+                let j = (grad_xi(&ehat, dn) * rp.jinv).determinant();
+                0.5 * bulk_penalty * (j - 1.0) * (j - 1.0) * rp.wdet
+            })
+            .sum()
+    }
+
+    /// Smallest and largest volume ratio J = det F over every point of the viscous,
+    /// penalty and mass rules and the check points ([`ShapeTables::check`]), with the
+    /// index of the point of the smallest (numbered viscous points first, then penalty,
+    /// mass, then check points by their index in the check table). The mass and check
+    /// points differ from the force points, so a field folding between those is seen.
+    pub fn volume_ratio_range(&self, e: &Compact, tables: &ShapeTables) -> (f64, usize, f64) {
+        let ehat = scaled(e, &self.scale);
+        let mut out = (f64::INFINITY, 0, f64::NEG_INFINITY);
+        let rules = [(&self.viscous, &tables.viscous), (&self.penalty, &tables.penalty), (&self.mass, &tables.mass)];
+        let mut k = 0;
+        for (pts, table) in rules {
+            for (rp, dn) in pts.iter().zip(&table.dn) {
+                let j = (grad_xi(&ehat, dn) * rp.jinv).determinant();
+                if j.is_nan() || j < out.0 {
+                    out.0 = j;
+                    out.1 = k;
+                }
+                out.2 = out.2.max(j);
+                k += 1;
+            }
+        }
+        for (p, rp) in &self.check {
+            let j = (grad_xi(&ehat, &tables.check.dn[*p]) * rp.jinv).determinant();
+            if j.is_nan() || j < out.0 {
+                out.0 = j;
+                out.1 = k + p;
+            }
+            out.2 = out.2.max(j);
+        }
+        out
     }
 
     /// Internal force f = ∫ P : ∂F/∂e dV₀ of the element (compact, 96 entries

@@ -51,6 +51,59 @@ pub fn gauss_legendre(n: usize) -> Result<(Vec<f64>, Vec<f64>)> {
     Ok((x, w))
 }
 
+/// Nodes and weights of the `n`-point Gauss–Lobatto rule on [-1, 1] (n ≥ 2): the end
+/// points ±1 and the roots of P'_{n−1}, weights 2/(n(n−1) P_{n−1}(x)²); exact for
+/// polynomials of degree 2n − 3. Interior nodes by Newton iteration on P'_{n−1}.
+pub fn gauss_lobatto(n: usize) -> Result<(Vec<f64>, Vec<f64>)> {
+    if !(2..=MAX_GAUSS_POINTS).contains(&n) {
+        return Err(invalid(
+            "Gauss-Lobatto points per direction",
+            n,
+            &format!("an integer in [2, {MAX_GAUSS_POINTS}]"),
+        ));
+    }
+    let m = n - 1; // degree of the Legendre polynomial
+    let mf = m as f64;
+    // P_m(z) and P_{m-1}(z)
+    let legendre = |z: f64| {
+        let (mut p0, mut p1) = (1.0, z);
+        for k in 2..=m {
+            let kf = k as f64;
+            let p2 = ((2.0 * kf - 1.0) * z * p1 - (kf - 1.0) * p0) / kf;
+            p0 = p1;
+            p1 = p2;
+        }
+        (p1, p0)
+    };
+    let mut x = vec![0.0; n];
+    let mut w = vec![0.0; n];
+    for i in 0..n.div_ceil(2) {
+        let mut z = -(std::f64::consts::PI * i as f64 / mf).cos();
+        if i > 0 {
+            for _ in 0..100 {
+                let (pm, pm1) = legendre(z);
+                let d1 = mf * (z * pm - pm1) / (z * z - 1.0); // P'_m
+                let d2 = (2.0 * z * d1 - mf * (mf + 1.0) * pm) / (1.0 - z * z); // P''_m
+                let dz = d1 / d2;
+                z -= dz;
+                if dz.abs() < 1e-16 {
+                    break;
+                }
+            }
+        }
+        if 2 * i + 1 == n {
+            z = 0.0;
+        }
+        let (pm, _) = legendre(z);
+        let wi = 2.0 / (mf * (mf + 1.0) * pm * pm);
+        x[i] = z;
+        x[n - 1 - i] = -z;
+        w[i] = wi;
+        w[n - 1 - i] = wi;
+    }
+    Ok((x, w))
+}
+
 /// Tensor-product Gauss rule on the reference cube [-1, 1]^3.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CubeRule {
@@ -66,6 +119,16 @@ impl CubeRule {
     /// The `n × n × n` Gauss–Legendre rule.
     pub fn gauss(n: usize) -> Result<Self> {
         let (x, w) = gauss_legendre(n)?;
+        Ok(Self::tensor(n, &x, &w))
+    }
+
+    /// The `n × n × n` Gauss–Lobatto rule (its points include the cube's corners).
+    pub fn lobatto(n: usize) -> Result<Self> {
+        let (x, w) = gauss_lobatto(n)?;
+        Ok(Self::tensor(n, &x, &w))
+    }
+
+    fn tensor(n: usize, x: &[f64], w: &[f64]) -> Self {
         let mut points = Vec::with_capacity(n * n * n);
         let mut weights = Vec::with_capacity(n * n * n);
         for k in 0..n {
@@ -76,7 +139,7 @@ impl CubeRule {
                 }
             }
         }
-        Ok(Self { n, points, weights })
+        Self { n, points, weights }
     }
 
     /// Number of points.
@@ -109,6 +172,27 @@ mod tests {
             let q: f64 = x.iter().zip(&w).map(|(x, w)| w * x.powi(deg as i32)).sum();
             assert!((q - exact).abs() > 1e-6);
         }
+    }
+
+    #[test]
+    fn lobatto_rules_hold_the_end_points_and_integrate_degree_2n_minus_3() {
+        // textbook values (Abramowitz & Stegun 25.4.32): n = 4: ±1/√5 with weight 5/6
+        let (x, w) = gauss_lobatto(4).unwrap();
+        assert!((x[1] + 1.0 / 5f64.sqrt()).abs() < 1e-15 && (w[1] - 5.0 / 6.0).abs() < 1e-15, "{x:?} {w:?}");
+        for n in 2..=MAX_GAUSS_POINTS {
+            let (x, w) = gauss_lobatto(n).unwrap();
+            assert_eq!((x[0], x[n - 1]), (-1.0, 1.0), "n={n}");
+            assert!(x.windows(2).all(|p| p[0] < p[1]), "n={n}: {x:?}");
+            for deg in 0..=(2 * n - 3) {
+                let exact = if deg % 2 == 1 { 0.0 } else { 2.0 / (deg as f64 + 1.0) };
+                let q: f64 = x.iter().zip(&w).map(|(x, w)| w * x.powi(deg as i32)).sum();
+                assert!((q - exact).abs() < 1e-14, "n={n} deg={deg}: {q} vs {exact}");
+            }
+            let deg = 2 * n - 2;
+            let q: f64 = x.iter().zip(&w).map(|(x, w)| w * x.powi(deg as i32)).sum();
+            assert!((q - 2.0 / (deg as f64 + 1.0)).abs() > 1e-6, "n={n}: degree {deg} must not be exact");
+        }
+        assert!(gauss_lobatto(1).is_err() && gauss_lobatto(MAX_GAUSS_POINTS + 1).is_err());
     }
 
     #[test]

@@ -3,7 +3,9 @@
 //! Each wall is described by a function ψ(p) of a point p in the **tank frame** that is
 //! the (approximate) signed distance beyond the wall: ψ > 0 means the point has
 //! penetrated the wall by ψ. Its gradient ∇ψ points out of the liquid into the wall and
-//! has unit length on exact-distance walls (planes, the cylindrical shell). The contact
+//! has unit length on every wall (exact distances for planes and the cylindrical shell,
+//! first-order distances for the quadrics), so the contact stiffness k_p is the same
+//! everywhere on the walls. The contact
 //! force is potential-like, F = −f_n(ψ, ψ̇) ∇ψ, so exact Jacobians need ∇ψ and ∇²ψ,
 //! which every wall provides analytically.
 //!
@@ -11,12 +13,13 @@
 //! |---|---|
 //! | plane n·p = d | n·p − d (exact) |
 //! | cylindrical shell radius R (axis x) | √(y²+z²) − R (exact) |
-//! | half-ellipsoidal head, depth d, centre x_c | R(√φ − 1), φ = (x−x_c)²/d² + (y²+z²)/R² |
-//! | elliptical shell, semi-axes a (y), b (z) | √(ab)(√(y²/a²+z²/b²) − 1) |
+//! | half-ellipsoidal head, depth d, centre x_c | (g − 1)/\|∇g\|, g = √φ, φ = (x−x_c)²/d² + (y²+z²)/R² |
+//! | elliptical shell, semi-axes a (y), b (z) | (g − 1)/\|∇g\|, g = √(y²/a²+z²/b²) |
 //! | bulkhead at x_b, thickness t, liquid on side s = ±1 | t/2 − s(x − x_b) |
 //!
-//! The head ψ equals the shell ψ, with the same gradient, on the tangent plane x = x_c,
-//! so the tank wall is C¹ across the head/shell junction; on a sphere (d = R) it is exact.
+//! The head ψ equals the shell ψ, with the same gradient, on the tangent plane x = x_c
+//! (there g = ρ/R and |∇g| = 1/R, so ψ = ρ − R; ∂ψ/∂x = 0 on both sides), so the tank
+//! wall is C¹ across the head/shell junction; on a sphere (d = R) it is exact.
 
 use crate::constitutive::M3;
 use crate::error::{Result, check_positive, invalid};
@@ -171,14 +174,14 @@ impl TankGeometry {
                     let dx = x - xc * x.signum();
                     let inv = [1.0 / (hd * hd), 1.0 / (r * r), 1.0 / (r * r)];
                     let q = [dx, y, z];
-                    if let Some(h) = quadric_hit(&q, &inv, r, hessian) {
+                    if let Some(h) = quadric_hit(&q, &inv, hessian) {
                         sink(h);
                     }
                 }
             }
             TankShape::EllipticCylinder { length, semi_axis_y: a, semi_axis_z: b } => {
                 let inv = [0.0, 1.0 / (a * a), 1.0 / (b * b)];
-                if let Some(h) = quadric_hit(&[0.0, y, z], &inv, (a * b).sqrt(), hessian) {
+                if let Some(h) = quadric_hit(&[0.0, y, z], &inv, hessian) {
                     sink(h);
                 }
                 plane(p, [1.0, 0.0, 0.0], 0.5 * length, &mut sink);
@@ -312,25 +315,48 @@ fn plane(p: [f64; 3], n: [f64; 3], d: f64, sink: &mut impl FnMut(WallHit)) {
     }
 }
 
-/// ψ = s(√φ − 1) with φ = Σ q_i² inv_i, if positive (∇²ψ only with `hessian`).
-fn quadric_hit(q: &[f64; 3], inv: &[f64; 3], s: f64, hessian: bool) -> Option<WallHit> {
-    let phi: f64 = (0..3).map(|i| q[i] * q[i] * inv[i]).sum();
-    let sq = phi.sqrt();
-    let psi = s * (sq - 1.0);
-    if psi <= 0.0 {
+/// ψ = (g − 1)/|∇g| with the gauge g = √φ, φ = Σ inv_i q_i², if positive (∇²ψ only with
+/// `hessian`): the first-order distance beyond the quadric g = 1. Since g is homogeneous of
+/// degree 1, |∇g| is constant along rays from the centre, ψ grows linearly along them, and
+/// |∇ψ| = 1 on the wall, so the wall is equally stiff everywhere (the earlier
+/// ψ = s(√φ − 1) had |∇ψ| = s|∇g|: 3× the shell's at the tip of a 0.5 m head on a 1.5 m
+/// shell, i.e. 9× its contact stiffness, issue 16).
+///
+/// With A = D q, B = D² q (D = diag(inv)), w = |A|², r = φ/w, u = 1/|∇g| = √r:
+/// ∇g = A/g, ∇²g = D/g − A Aᵀ/g³, ∇r = 2(A − r B)/w, ∇u = (A − r B)/(u w),
+/// ∇²u = (A − r B) ∇(1/(u w))ᵀ + (D − r D² − B ∇rᵀ)/(u w) with
+/// ∇(1/(u w)) = −∇r/(2 u³ w) − 2 B/(u w²), and
+/// ∇ψ = u ∇g + (g − 1) ∇u, ∇²ψ = u ∇²g + ∇g ∇uᵀ + ∇u ∇gᵀ + (g − 1) ∇²u.
+fn quadric_hit(q: &[f64; 3], inv: &[f64; 3], hessian: bool) -> Option<WallHit> {
+    let a: [f64; 3] = std::array::from_fn(|i| inv[i] * q[i]);
+    let b: [f64; 3] = std::array::from_fn(|i| inv[i] * a[i]);
+    let phi: f64 = (0..3).map(|i| q[i] * a[i]).sum();
+    let g = phi.sqrt();
+    if g <= 1.0 {
         return None;
     }
-    // ∇φ = 2 inv q; ∇ψ = s ∇φ / (2√φ); ∇²ψ = s [∇²φ/(2√φ) − ∇φ∇φᵀ/(4 φ^{3/2})]
-    let gphi = [2.0 * inv[0] * q[0], 2.0 * inv[1] * q[1], 2.0 * inv[2] * q[2]];
-    let grad = [s * gphi[0] / (2.0 * sq), s * gphi[1] / (2.0 * sq), s * gphi[2] / (2.0 * sq)];
+    let w: f64 = a.iter().map(|x| x * x).sum();
+    let r = phi / w;
+    let u = r.sqrt();
+    let psi = (g - 1.0) * u;
+    let c: [f64; 3] = std::array::from_fn(|i| a[i] - r * b[i]); // A − r B
+    let grad_g: [f64; 3] = std::array::from_fn(|i| a[i] / g);
+    let grad_u: [f64; 3] = std::array::from_fn(|i| c[i] / (u * w));
+    let grad = std::array::from_fn(|i| u * grad_g[i] + (g - 1.0) * grad_u[i]);
     let mut hess = M3::zeros();
     if hessian {
+        let grad_r: [f64; 3] = std::array::from_fn(|i| 2.0 * c[i] / w);
+        let grad_k: [f64; 3] = std::array::from_fn(|i| -grad_r[i] / (2.0 * u * u * u * w) - 2.0 * b[i] / (u * w * w));
         for i in 0..3 {
             for j in 0..3 {
-                let d = if i == j { 2.0 * inv[i] / (2.0 * sq) } else { 0.0 };
-                hess[(i, j)] = s * (d - gphi[i] * gphi[j] / (4.0 * phi * sq));
+                let d = if i == j { inv[i] } else { 0.0 };
+                let hg = d / g - a[i] * a[j] / (g * g * g);
+                let hu = c[i] * grad_k[j] + (d - r * d * inv[i] - b[i] * grad_r[j]) / (u * w);
+                hess[(i, j)] = u * hg + grad_g[i] * grad_u[j] + grad_u[i] * grad_g[j] + (g - 1.0) * hu;
             }
         }
+        // the formula is symmetric up to round-off; make it exactly so
+        hess = 0.5 * (hess + hess.transpose());
     }
     Some(WallHit { psi, grad, hess })
 }
@@ -338,6 +364,7 @@ fn quadric_hit(q: &[f64; 3], inv: &[f64; 3], s: f64, hessian: bool) -> Option<Wa
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::Vector3;
 
     fn fd_check(g: &TankGeometry, p: [f64; 3]) {
         let mut hits = Vec::new();
@@ -393,6 +420,42 @@ mod tests {
         // nothing inside
         g.hits([0.0, 0.0, 0.0], &[], &mut a);
         assert!(a.is_empty());
+    }
+
+    #[test]
+    fn quadric_walls_are_unit_gradient_distances_near_the_wall() {
+        // just beyond the wall, at the tip and the rim of a head and around an ellipse:
+        // ψ ≈ the distance along the normal, |∇ψ| = 1 (the old ψ = R(√φ − 1) gave 3 at
+        // the tip of this head)
+        let cyl =
+            TankGeometry::new(TankShape::Cylinder { length: 11.0, radius: 1.5, head_depth: 0.5 }, vec![]).unwrap();
+        let ell = TankGeometry::new(
+            TankShape::EllipticCylinder { length: 0.324, semi_axis_y: 0.2086, semi_axis_z: 0.1321 },
+            vec![],
+        )
+        .unwrap();
+        let mut h = Vec::new();
+        let eps = 1e-4;
+        for k in 0..=8 {
+            let t = std::f64::consts::FRAC_PI_2 * k as f64 / 8.0;
+            // head surface point at polar angle t from the axis, pushed out along the normal
+            let (x, rho) = (5.5 + 0.5 * t.cos(), 1.5 * t.sin());
+            let n = Vector3::new(t.cos() / 0.5, 0.0, -t.sin() / 1.5).normalize();
+            let p = Vector3::new(x, 0.0, -rho) + eps * n;
+            cyl.hits([p[0], p[1], p[2]], &[], &mut h);
+            let hit = h.iter().max_by(|a, b| a.psi.total_cmp(&b.psi)).unwrap();
+            let gn = Vector3::from(hit.grad).norm();
+            assert!((gn - 1.0).abs() < 1e-3, "head, angle {t}: |grad| = {gn}");
+            assert!((hit.psi - eps).abs() < 1e-3 * eps + 1e-9, "head, angle {t}: psi = {}", hit.psi);
+            // ellipse point at angle t, pushed out along its normal
+            let (a, b) = (0.2086, 0.1321);
+            let n = Vector3::new(0.0, t.cos() / a, t.sin() / b).normalize();
+            let p = Vector3::new(0.0, a * t.cos(), b * t.sin()) + eps * n;
+            ell.hits([p[0], p[1], p[2]], &[], &mut h);
+            let hit = h[0];
+            assert!((Vector3::from(hit.grad).norm() - 1.0).abs() < 1e-3, "ellipse, angle {t}");
+            assert!((hit.psi - eps).abs() < 1e-3 * eps + 1e-9, "ellipse, angle {t}: psi = {}", hit.psi);
+        }
     }
 
     #[test]

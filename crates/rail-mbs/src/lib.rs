@@ -2,6 +2,7 @@
 //!
 //! Modules are grouped by physics:
 //! - [`cosim`]: the slosh model as a co-simulation participant (seed 003);
+//! - [`invariants`]: run-time checks of every fluid run (containment, energy, element validity);
 //! - [`integrator`]: the sparse implicit HHT-α integrator (faer sparse LU) that advances
 //!   rigid and ANCF bodies together;
 //! - [`track`]: track geometry from segment tables;
@@ -11,6 +12,7 @@
 
 pub mod cosim;
 pub mod integrator;
+pub mod invariants;
 pub mod mbs;
 pub mod profile;
 pub mod slosh;

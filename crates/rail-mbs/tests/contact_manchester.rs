@@ -2,7 +2,8 @@
 //! compared with CONTACT's reference output (`mbench_a22_left.ref_out`, Apache-2.0).
 //!
 //! The data are read from `../shared/data/manchester-contact` relative to the workspace
-//! root; the test is skipped (with a message) when the folder is absent.
+//! root; without them the tests fail under CI and are skipped visibly elsewhere
+//! (`common::data_missing`).
 //!
 //! Frames: CONTACT's track frame has x forward, y to the **right**, z **down**; ours has
 //! x forward, y left, z up. Hence `y_ours = −y_C`, `roll_ours = roll_C` (same physical
@@ -12,6 +13,8 @@
 
 use std::path::PathBuf;
 
+mod common;
+
 use nalgebra::{Matrix3, Vector3};
 use rail_mbs::wheel_rail::{ContactPoint, CreepModel, WheelPose, WheelRailContact};
 
@@ -20,7 +23,7 @@ fn data_dir() -> Option<PathBuf> {
     if p.join("mbench_a22_left.ref_out").is_file() {
         Some(p)
     } else {
-        eprintln!("SKIP: Manchester contact data not found at {} — test skipped", p.display());
+        common::data_missing(&format!("Manchester contact data at {}", p.display()));
         None
     }
 }

@@ -442,7 +442,8 @@ impl PyFluidBody {
 #[pyo3(signature = (mesh, fluid, tank_shape, tank_dims, bulkheads, acceleration, rotation_axis, angular_acceleration,
                     t_end, h, frame="inertial", gravity=[0.0, 0.0, -9.81], viscous_points=3, penalty_points=3,
                     progress=None, volume_tolerance=0.01, penetration_limit=0.5, contact_stiffness_factor=1.0,
-                    stream=None, checkpoint=None, checkpoint_every=100, resume_from=None))]
+                    stream=None, checkpoint=None, checkpoint_every=100, resume_from=None,
+                    contact_points_per_edge=3, contact_point_rule="gauss"))]
 #[allow(clippy::too_many_arguments)]
 fn run_slosh<'py>(
     py: Python<'py>,
@@ -468,8 +469,10 @@ fn run_slosh<'py>(
     checkpoint: Option<std::path::PathBuf>,
     checkpoint_every: usize,
     resume_from: Option<std::path::PathBuf>,
+    contact_points_per_edge: usize,
+    contact_point_rule: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
-    use ancf_core::contact::{WallContact, WallContactLaw};
+    use ancf_core::contact::{ContactPointRule, WallContact, WallContactLaw};
     use ancf_core::tank::{Bulkhead, TankGeometry, TankShape};
     use rail_mbs::slosh::{PiecewiseAcceleration, PrescribedMotion, SloshFrame, SloshRun, SloshSystem};
     let bad =
@@ -487,6 +490,11 @@ fn run_slosh<'py>(
                 "cylinder [length, radius, head_depth], elliptic [length, semi_axis_y, semi_axis_z] or box [min xyz, max xyz]",
             ));
         }
+    };
+    let point_rule = match contact_point_rule {
+        "gauss" => ContactPointRule::Gauss,
+        "lobatto" => ContactPointRule::Lobatto,
+        other => return Err(bad("contact_point_rule", format!("{other:?}"), "\"gauss\" or \"lobatto\"")),
     };
     let frame = match frame {
         "inertial" => SloshFrame::Inertial,
@@ -523,6 +531,8 @@ fn run_slosh<'py>(
         // k × s with the damping ratio of the default law kept (c ∝ k^1.5 there)
         law.stiffness *= contact_stiffness_factor;
         law.damping *= contact_stiffness_factor.powf(1.5);
+        law.points_per_edge = contact_points_per_edge;
+        law.point_rule = point_rule;
         let contact = WallContact::new(&body, geo, law)?;
         let mut motion = PrescribedMotion::at_rest([0.0; 3]);
         let names = ["acceleration.x", "acceleration.y", "acceleration.z"];
@@ -577,10 +587,11 @@ fn run_slosh<'py>(
         };
         let err = result.err().map(|e| e.error.to_string());
         let s = *run.stats();
-        Ok((run.record, err, s))
+        let margins = run.margins();
+        Ok((run.record, err, s, margins))
     })?;
     observer.finish()?;
-    let (rec, err, stats) = result;
+    let (rec, err, stats, margins) = result;
     let d = PyDict::new(py);
     let v3 = |x: &Vec<[f64; 3]>| -> PyResult<Bound<'py, PyAny>> {
         let n = x.len();
@@ -597,6 +608,12 @@ fn run_slosh<'py>(
     d.set_item("potential_energy", PyArray1::from_vec(py, rec.potential_energy))?;
     d.set_item("newton_iterations", PyArray1::from_vec(py, rec.newton_iterations.iter().map(|&x| x as i64).collect()))?;
     d.set_item("max_penetration", PyArray1::from_vec(py, rec.max_penetration))?;
+    d.set_item("stored_energy", PyArray1::from_vec(py, rec.stored_energy))?;
+    d.set_item("input_work", PyArray1::from_vec(py, rec.input_work))?;
+    d.set_item("energy_error", PyArray1::from_vec(py, rec.energy_error))?;
+    d.set_item("min_volume_ratio", PyArray1::from_vec(py, rec.min_volume_ratio))?;
+    d.set_item("containment_gap", PyArray1::from_vec(py, rec.containment_gap))?;
+    d.set_item("margins", margins_dict(py, &margins)?)?;
     d.set_item("error", err)?;
     let st = PyDict::new(py);
     st.set_item("steps", stats.steps)?;
@@ -609,6 +626,21 @@ fn run_slosh<'py>(
     st.set_item("time_solve", stats.time_solve.as_secs_f64())?;
     st.set_item("time_total", stats.time_total.as_secs_f64())?;
     d.set_item("stats", st)?;
+    Ok(d)
+}
+
+/// The worst invariant margins of a run (`rail_mbs::invariants::Margins`) as a dict
+/// (`worst_energy_error` None where no energy account is kept).
+pub(crate) fn margins_dict<'py>(py: Python<'py>, m: &rail_mbs::invariants::Margins) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("worst_gap", m.worst_gap)?;
+    d.set_item("worst_gap_time", m.worst_gap_time)?;
+    // not measured (vehicle runs keep no energy account): None
+    d.set_item("worst_energy_error", m.worst_energy_error.is_finite().then_some(m.worst_energy_error))?;
+    d.set_item("worst_energy_time", m.worst_energy_time)?;
+    d.set_item("min_volume_ratio", m.min_volume_ratio)?;
+    d.set_item("min_volume_ratio_time", m.min_volume_ratio_time)?;
+    d.set_item("dissipated", m.dissipated)?;
     Ok(d)
 }
 

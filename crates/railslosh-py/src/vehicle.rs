@@ -294,6 +294,7 @@ fn fluid_record_dict<'py>(py: Python<'py>, r: &FluidTrainRecord) -> PyResult<Bou
     }
     d.set_item("snapshots", snaps)?;
     d.set_item("fluid_mass", r.fluid_mass)?;
+    d.set_item("margins", crate::margins_dict(py, &r.margins)?)?;
     d.set_item("elements", r.elements)?;
     let conn: Vec<i64> = r.connectivity.iter().flatten().map(|&n| n as i64).collect();
     let ne = r.connectivity.len();

@@ -97,6 +97,57 @@ pub enum SystemError {
         /// Admissible relative error.
         limit: f64,
     },
+    /// An element's volume ratio J = det F fell below the admissible floor (> 0) at a
+    /// quadrature point (run-time invariant, see [`crate::invariants`]).
+    #[error("element {element} distorted: J = {j:.3e} at quadrature point {point}, below its limit {limit:.3e}")]
+    DistortedElement {
+        /// Element index in the system's own numbering.
+        element: usize,
+        /// Quadrature point (viscous, then penalty, then mass points).
+        point: usize,
+        /// Volume ratio there.
+        j: f64,
+        /// Admissible floor.
+        limit: f64,
+    },
+    /// Liquid left its tank: a fluid node, contact point or the centre of mass lies
+    /// beyond a wall by more than the admissible gap (run-time invariant, see
+    /// [`crate::invariants`]).
+    #[error(
+        "{what} not contained: {site} at tank-frame ({:.4}, {:.4}, {:.4}) m is {depth:.3e} m beyond the wall (limit {limit:.3e} m)",
+        position[0], position[1], position[2]
+    )]
+    Containment {
+        /// Which liquid (e.g. "fluid", "car 0 fluid").
+        what: String,
+        /// Which node, point or the centre of mass.
+        site: String,
+        /// Its tank-frame position, m.
+        position: [f64; 3],
+        /// Gap beyond the wall, m.
+        depth: f64,
+        /// Admissible gap, m.
+        limit: f64,
+    },
+    /// The liquid's energy grew beyond what the walls put in (run-time invariant, see
+    /// [`crate::invariants`]): no physical mechanism creates energy.
+    #[error(
+        "{what} energy balance broken: E = {energy:.6e} J, E0 = {initial:.6e} J, work put in {input_work:.6e} J: growth {relative:.3e} of the energy scale (limit {limit:.3e})"
+    )]
+    EnergyGrowth {
+        /// Which liquid.
+        what: String,
+        /// Kinetic + potential + stored energy now, J.
+        energy: f64,
+        /// Its initial value, J.
+        initial: f64,
+        /// Work put into the liquid so far (walls, or gravity and pseudo-forces), J.
+        input_work: f64,
+        /// Growth (E − E0 − W) relative to the energy scale.
+        relative: f64,
+        /// Admissible growth.
+        limit: f64,
+    },
     /// Any other model failure.
     #[error("{0}")]
     Other(String),
@@ -277,6 +328,12 @@ pub enum FailureCause {
     NonFinite,
     /// The linear solver failed for another reason (memory, overflow).
     LinearSolver,
+    /// Liquid left its tank (run-time invariant).
+    Containment,
+    /// The liquid's energy grew beyond the work put in (run-time invariant).
+    EnergyGrowth,
+    /// An element distorted beyond the admissible volume ratio (run-time invariant).
+    DistortedElement,
     /// Another model failure.
     Model,
 }
@@ -293,6 +350,9 @@ impl FailureCause {
             Self::SingularConstraints => "singular_constraints",
             Self::NonFinite => "non_finite",
             Self::LinearSolver => "linear_solver",
+            Self::Containment => "containment",
+            Self::EnergyGrowth => "energy_growth",
+            Self::DistortedElement => "distorted_element",
             Self::Model => "model",
         }
     }
@@ -328,6 +388,9 @@ impl IntegratorError {
                 SystemError::InvertedElement { .. } => FailureCause::InvertedElement,
                 SystemError::Penetration { .. } => FailureCause::ContactPenetration,
                 SystemError::VolumeError { .. } => FailureCause::VolumeError,
+                SystemError::Containment { .. } => FailureCause::Containment,
+                SystemError::EnergyGrowth { .. } => FailureCause::EnergyGrowth,
+                SystemError::DistortedElement { .. } => FailureCause::DistortedElement,
                 _ => FailureCause::Model,
             },
         }

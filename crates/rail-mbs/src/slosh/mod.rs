@@ -5,6 +5,7 @@
 //! integrator loop) → [`SloshRecord`] (time series, recorded every step); [`modes`] gives the
 //! small-amplitude modes of a [`SloshSystem`] about a state at rest.
 
+pub mod linear_theory;
 pub mod modes;
 pub mod motion;
 pub mod system;
@@ -17,6 +18,7 @@ pub use system::{SloshFrame, SloshSystem};
 use nalgebra::Vector3;
 
 use crate::integrator::{Checkpoint, CheckpointFile, Hht, HhtParams, IntegratorError, Journal, Stats};
+use crate::invariants::{EnergySample, InvariantMonitor, Margins};
 use crate::vehicle::{Observer, Progress};
 
 /// Time series recorded by a slosh run. Loads are the force and moment the fluid exerts on
@@ -45,11 +47,22 @@ pub struct SloshRecord {
     pub newton_iterations: Vec<usize>,
     /// Largest wall penetration (m).
     pub max_penetration: Vec<f64>,
+    /// Stored elastic energy: volumetric penalty + contact springs (J).
+    pub stored_energy: Vec<f64>,
+    /// Work put into the liquid since the start (J): by the walls (inertial frame), or by
+    /// gravity and the pseudo-forces (tank frame); see [`crate::invariants`].
+    pub input_work: Vec<f64>,
+    /// Energy growth ε = (E − E₀ − W_in)/E_ref (≤ 0 for a physical run; [`crate::invariants`]).
+    pub energy_error: Vec<f64>,
+    /// Smallest volume ratio J = det F at any quadrature point.
+    pub min_volume_ratio: Vec<f64>,
+    /// Largest wall gap of any fluid node, contact point or the centre of mass (m).
+    pub containment_gap: Vec<f64>,
 }
 
 impl SloshRecord {
     /// Column names of [`SloshRecord::row`] (vectors as `_x`, `_y`, `_z`).
-    pub const COLUMNS: [&'static str; 21] = [
+    pub const COLUMNS: [&'static str; 26] = [
         "t",
         "force_tank_x",
         "force_tank_y",
@@ -71,6 +84,11 @@ impl SloshRecord {
         "potential_energy",
         "newton_iterations",
         "max_penetration",
+        "stored_energy",
+        "input_work",
+        "energy_error",
+        "min_volume_ratio",
+        "containment_gap",
     ];
 
     /// Sample `i` as one row of [`SloshRecord::COLUMNS`].
@@ -85,6 +103,11 @@ impl SloshRecord {
             self.potential_energy[i],
             self.newton_iterations[i] as f64,
             self.max_penetration[i],
+            self.stored_energy[i],
+            self.input_work[i],
+            self.energy_error[i],
+            self.min_volume_ratio[i],
+            self.containment_gap[i],
         ]);
         r
     }
@@ -99,6 +122,9 @@ pub struct SloshRun {
     /// Periodic checkpoints (`None`: none written): after every accepted step the file
     /// is rewritten once `every` steps have passed since the last one (issue 8).
     pub checkpoints: Option<CheckpointFile>,
+    /// The run-time invariants, checked on every accepted step (issue 16). A resumed
+    /// run starts its energy account at the checkpoint.
+    pub invariants: InvariantMonitor,
 }
 
 /// A failed run: the error and everything recorded up to it.
@@ -120,9 +146,10 @@ impl SloshRun {
     /// Start at t0 from the system's initial state (fluid moving rigidly with the tank).
     pub fn new(system: SloshSystem, t0: f64, params: HhtParams) -> Result<Self, IntegratorError> {
         let (q, v) = system.initial_state(t0);
+        let invariants = system.invariant_monitor();
         let hht = Hht::new(system, t0, q, v, params)?;
-        let mut run = Self { hht, record: SloshRecord::default(), checkpoints: None };
-        run.record_state(0);
+        let mut run = Self { hht, record: SloshRecord::default(), checkpoints: None, invariants };
+        run.record_state(0)?;
         Ok(run)
     }
 
@@ -131,9 +158,10 @@ impl SloshRun {
     /// the continuation is bitwise identical to the uninterrupted run's (its first
     /// sample reports 0 Newton iterations).
     pub fn resume(system: SloshSystem, checkpoint: &Checkpoint, params: HhtParams) -> Result<Self, IntegratorError> {
+        let invariants = system.invariant_monitor();
         let hht = Hht::restore(system, checkpoint, params)?;
-        let mut run = Self { hht, record: SloshRecord::default(), checkpoints: None };
-        run.record_state(0);
+        let mut run = Self { hht, record: SloshRecord::default(), checkpoints: None, invariants };
+        run.record_state(0)?;
         Ok(run)
     }
 
@@ -169,7 +197,7 @@ impl SloshRun {
         while t_end - self.hht.t() > 1e-12 * (1.0 + t_end.abs()) {
             let h_step = h.min(t_end - self.hht.t());
             match self.hht.step(h_step) {
-                Ok(info) => self.record_state(info.iterations),
+                Ok(info) => self.record_state(info.iterations).map_err(|e| fail(self, e))?,
                 Err(error) => return Err(fail(self, error)),
             }
             if let Some(j) = journal.as_deref_mut() {
@@ -208,7 +236,15 @@ impl SloshRun {
         self.hht.stats()
     }
 
-    fn record_state(&mut self, iterations: usize) {
+    /// Worst invariant margins so far (containment gap, energy growth, volume ratio).
+    pub fn margins(&self) -> Margins {
+        self.invariants.margins()
+    }
+
+    /// Records the current (accepted) state, then checks the run-time invariants on it
+    /// ([`crate::invariants`]): a violation is returned as a located error at this time,
+    /// with the violating sample recorded.
+    fn record_state(&mut self, iterations: usize) -> Result<(), IntegratorError> {
         let sys = self.hht.system();
         let (t, q, v) = (self.hht.t(), self.hht.q(), self.hht.v());
         let load = sys.contact_load(t, q, v);
@@ -226,6 +262,8 @@ impl SloshRun {
             SloshFrame::Tank => com,
         };
         // inertial velocity and position for the energies
+        let kin = sys.contact_kinematics(t);
+        let stored = crate::invariants::stored_energy(body, &sys.contact, &kin, q);
         let (ke, pe) = match sys.frame {
             SloshFrame::Inertial => (body.kinetic_energy(v), body.potential_energy(q, sys.gravity)),
             SloshFrame::Tank => {
@@ -258,5 +296,29 @@ impl SloshRun {
         r.potential_energy.push(pe);
         r.newton_iterations.push(iterations);
         r.max_penetration.push(load.max_penetration);
+        r.stored_energy.push(stored);
+        let energy = match sys.frame {
+            SloshFrame::Inertial => EnergySample {
+                kinetic: ke,
+                potential: pe,
+                stored,
+                input_power: crate::invariants::wall_power(fg.into(), mg.into(), &state.kinematics),
+            },
+            SloshFrame::Tank => EnergySample {
+                kinetic: body.kinetic_energy(v),
+                potential: 0.0,
+                stored,
+                input_power: sys.frame_power(t, q, v),
+            },
+        };
+        let checked = self.invariants.check(t, body, &sys.contact, &kin, q, energy);
+        let m = checked.as_ref().ok();
+        let w = self.invariants.input_work();
+        r.input_work.push(m.map_or(w, |m| m.input_work));
+        r.energy_error.push(m.map_or(f64::NAN, |m| m.energy_error));
+        let margins = self.invariants.margins();
+        r.min_volume_ratio.push(m.map_or(margins.min_volume_ratio, |m| m.min_volume_ratio));
+        r.containment_gap.push(m.map_or(margins.worst_gap, |m| m.gap));
+        checked.map(|_| ()).map_err(|source| IntegratorError::System { t, source })
     }
 }

@@ -51,8 +51,9 @@ pub struct SloshSystem {
     /// sparse LU; [`LinearSolverKind::Iterative`] scales linearly to large meshes.
     pub linear_solver: LinearSolverKind,
     /// Largest admissible wall/bulkhead penetration (m), checked on every converged step
-    /// ([`SystemError::Penetration`]). Default: [`PENETRATION_LIMIT_FACTOR`] × the
-    /// smallest element edge.
+    /// ([`SystemError::Penetration`]), and the containment limit of the run-time
+    /// invariants ([`crate::invariants::check_state`], also on every converged step).
+    /// Default: [`PENETRATION_LIMIT_FACTOR`] × the smallest element edge.
     pub penetration_limit: f64,
     /// Admissible relative volume error of the fluid, checked on every converged step
     /// ([`SystemError::VolumeError`]). Default 0.01.
@@ -70,6 +71,23 @@ pub struct SloshSystem {
     /// Reused buffers: force evaluation and element Jacobians.
     workspace: ForceWorkspace,
     jacobians: Vec<ElementJacobian>,
+}
+
+impl SloshSystem {
+    /// The run-time invariant monitor of this system ([`crate::invariants`]): containment
+    /// within its penetration limit, default energy and volume-ratio limits.
+    pub fn invariant_monitor(&self) -> crate::invariants::InvariantMonitor {
+        let nodes = &self.body.mesh.nodes;
+        let depth = self.body.mesh.free_surface_z - nodes.iter().map(|n| n[2]).fold(f64::INFINITY, f64::min);
+        let g = Vector3::from(self.gravity).norm();
+        crate::invariants::InvariantMonitor::new(
+            "fluid",
+            crate::invariants::InvariantLimits::new(self.penetration_limit),
+            self.body.total_mass(),
+            g,
+            depth.max(0.0),
+        )
+    }
 }
 
 /// Default penetration limit relative to the smallest element edge: a contact point
@@ -245,6 +263,35 @@ impl SloshSystem {
         eb[8 * (a / 4) + b / 4] + (3 * (a % 4) + i) * 12 + 3 * (b % 4) + k
     }
 
+    /// Tank-frame formulation: the power of gravity and of the pseudo-forces on the
+    /// liquid, (Q_gravity + Q_pseudo)·ė (W). The Coriolis term −2 M_s⊗ω̃ ė does no work
+    /// (M_s symmetric, ω̃ skew), so only −(∫ρN)⊗(g − a) and −M_s⊗(ω̃̇ + ω̃²) e count.
+    /// Zero in the inertial formulation, where the walls' work is the input instead.
+    pub fn frame_power(&self, t: f64, q: &[f64], v: &[f64]) -> f64 {
+        if self.frame != SloshFrame::Tank {
+            return 0.0;
+        }
+        let (g, alin, _, _) = self.tank_frame_terms(t);
+        let acc = g - alin;
+        let mut p: f64 = self
+            .body
+            .gravity_scale()
+            .iter()
+            .zip(v.chunks_exact(3))
+            .map(|(s, vs)| s * acc.dot(&Vector3::new(vs[0], vs[1], vs[2])))
+            .sum();
+        if let Some((b, _)) = self.rotation_terms(t) {
+            let m = self.body.scalar_mass().as_ref();
+            for j in 0..m.ncols() {
+                let bj = b * Vector3::new(q[3 * j], q[3 * j + 1], q[3 * j + 2]);
+                for (i, val) in m.row_idx_of_col(j).zip(m.val_of_col(j)) {
+                    p -= val * Vector3::new(v[3 * i], v[3 * i + 1], v[3 * i + 2]).dot(&bj);
+                }
+            }
+        }
+        p
+    }
+
     /// Contact load on the tank at a state (global components in the inertial formulation,
     /// tank components in the tank-frame formulation).
     pub fn contact_load(&self, t: f64, q: &[f64], v: &[f64]) -> ContactLoad {
@@ -351,6 +398,13 @@ impl MechanicalSystem for SloshSystem {
                 limit: self.volume_tolerance,
             });
         }
+        // the state invariants (containment of nodes, contact points and centre of mass;
+        // element validity) for every run kind built on this system: slosh runs, the
+        // co-simulation participant and the FMU
+        let limits = crate::invariants::InvariantLimits::new(self.penetration_limit);
+        let kin = self.contact_kinematics(t);
+        crate::invariants::check_state(|| "fluid".into(), &self.body, &self.contact, &kin, q, &limits)
+            .map_err(|(error, _, _)| error)?;
         Ok(())
     }
 

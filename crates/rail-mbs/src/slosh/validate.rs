@@ -8,6 +8,7 @@
 //! | `slosh-viscous-decay` | free sloshing after a pulse decays faster from water through the light, medium and heavy crudes of seed 000 Table 2; the heavy crude settles within one period |
 //! | `bulkhead-longitudinal` | under the same braking pulse, a tank car divided into three compartments by two bulkheads has a lower peak longitudinal load than the open tank |
 //! | `tank-frame-equivalence` | the same motion given as tank-frame pseudo-forces (seed 003 eq. 7.40) and as prescribed inertial motion gives the same loads |
+//! | `slosh-linear-potential-flow` | seed 003's rectangular tank under a 0.03 g lateral pulse (linear regime): the lateral load history vs the 50-mode linear potential-flow solution ([`super::linear_theory`]), RMS difference over 0.5–4 s ≤ 10 % of its peak; first-mode frequency from zero crossings vs 1.436 Hz |
 //!
 //! `quick` selects coarser meshes and shorter runs (as run in CI); the full forms are the
 //! long validation (`railslosh validate`).
@@ -28,13 +29,15 @@ use crate::integrator::{AdaptiveParams, HhtParams, StepControl};
 pub const G: f64 = 9.81;
 
 /// Names of the slosh cases.
-pub const CASES: [&str; 6] = [
+pub const CASES: [&str; 8] = [
     "hydrostatic-cylinder",
     "slosh-rect-tank",
     "slosh-cylinder-half",
     "slosh-viscous-decay",
     "tank-frame-equivalence",
     "bulkhead-longitudinal",
+    "slosh-linear-potential-flow",
+    "slosh-load-convergence",
 ];
 
 /// Run a slosh case by name.
@@ -46,6 +49,8 @@ pub fn run_case(name: &str, quick: bool) -> Result<Vec<Record>> {
         "slosh-cylinder-half" => slosh_cylinder_half(quick),
         "slosh-viscous-decay" => slosh_viscous_decay(quick),
         "bulkhead-longitudinal" => bulkhead_longitudinal(quick),
+        "slosh-linear-potential-flow" => slosh_linear_potential_flow(quick),
+        "slosh-load-convergence" => slosh_load_convergence(quick),
         other => Err(ancf_core::error::invalid("case", other, &format!("one of {CASES:?}"))),
     }
 }
@@ -575,13 +580,19 @@ fn bulkhead_longitudinal(quick: bool) -> Result<Vec<Record>> {
         peaks.push(peak / (mass * 0.1 * G));
     }
     Ok(vec![
+        // Bounds of the open tank's peak, from linear sloshing: the load is the rigid part
+        // (m − Σ m_n) a plus each mode's spring force, whose response to a (ramped) step of
+        // a is at most twice its quasi-static m_n a (undamped step response). Summed:
+        // m a ≤ peak ≤ (m − Σ m_n + 2 Σ m_n) a ≤ 2 m a, with a = 0.1 g.
         Record {
             case: c.into(),
-            quantity: "open tank: peak longitudinal load / (m 0.1 g), must exceed the quasi-static value 1".into(),
+            quantity:
+                "open tank: peak longitudinal load / (m 0.1 g), between 1 (quasi-static) and 2 (undamped step response)"
+                    .into(),
             measured: peaks[0],
-            reference: 1.0,
-            tolerance: 0.0,
-            passed: peaks[0] > 1.0 && peaks[0].is_finite(),
+            reference: 1.5,
+            tolerance: 0.5,
+            passed: peaks[0] > 1.0 && peaks[0] <= 2.0,
         },
         Record {
             case: c.into(),
@@ -594,4 +605,200 @@ fn bulkhead_longitudinal(quick: bool) -> Result<Vec<Record>> {
             passed: peaks[1] < peaks[0],
         },
     ])
+}
+
+/// Mean frequency (Hz) of `x(t)` over [ta, tb] from its zero crossings: the signal is
+/// resampled every 1 ms, smoothed by a centred 51 ms moving average (removes contact chatter;
+/// it passes 99 % of a 1.4 Hz sine with no phase shift), and the crossing times found by
+/// linear interpolation; f = (crossings − 1) / (2 (last − first)).
+fn zero_crossing_frequency(t: &[f64], x: &[f64], ta: f64, tb: f64) -> f64 {
+    let n = ((tb - ta) / 1e-3).round() as usize;
+    let grid: Vec<f64> = (0..=n).map(|i| ta + (tb - ta) * i as f64 / n as f64).collect();
+    let y: Vec<f64> = resample(t, &|i| [x[i], 0.0, 0.0], &grid).iter().map(|v| v[0]).collect();
+    let w = 25;
+    let ys: Vec<f64> =
+        (w..y.len().saturating_sub(w)).map(|i| y[i - w..=i + w].iter().sum::<f64>() / (2 * w + 1) as f64).collect();
+    let gs = &grid[w..grid.len().saturating_sub(w)];
+    let crossings: Vec<f64> = ys
+        .windows(2)
+        .zip(gs.windows(2))
+        .filter(|(v, _)| v[0] * v[1] < 0.0 || (v[0] == 0.0 && v[1] != 0.0))
+        .map(|(v, g)| g[0] + (g[1] - g[0]) * v[0] / (v[0] - v[1]))
+        .collect();
+    if crossings.len() < 3 {
+        return f64::NAN;
+    }
+    (crossings.len() - 1) as f64 / (2.0 * (crossings[crossings.len() - 1] - crossings[0]))
+}
+
+/// `slosh-linear-potential-flow`: seed 003's rectangular tank (0.416 m long, 0.324 m wide,
+/// 0.132 m of water) under a lateral (y) pulse of 0.03 g, small enough for linear theory
+/// (linear theory gives a residual first-mode wall elevation of ≈ 8 mm after the pulse: 6 %
+/// of the depth, wave slope k₁η ≈ 0.07).
+/// The pulse: 0.03 g from 0.1 s to 0.5 s with 20 ms linear ramps (0.4 s ≈ 0.57 of the first
+/// period, which puts 97 % of the largest possible residual amplitude into mode 1). The
+/// lateral load on the tank (`force_tank` y) is compared with the 50-mode linear
+/// potential-flow solution ([`super::linear_theory::RectangularTankModes`], undamped, the
+/// ANCF liquid's mass) at the same times: RMS of the difference over 0.5–4 s, both on a
+/// 1 ms grid, divided by the modal solution's peak |F| over that window, ≤ 0.10.
+///
+/// Discretization: 4³ penalty points, 4×4 contact points per face and walls 100 × stiffer
+/// than the default (damping ×100^1.5, ζ kept), as in `slosh-cylinder-half`'s transverse
+/// slice. Measured with `slosh_modes` (linearization about the settled rest state, λ = ω²h/g,
+/// 2×6×2 mesh): the default discretization has λ_min = −0.10 (growth ≈ 2.7 1/s, a factor
+/// e¹¹ over the 4 s of this case), these settings −0.0009; the first lateral mode is
+/// λ = 1.093 (default) and 1.092 (these settings) vs 1.096 analytic; on the 2×8×3 mesh
+/// λ_min = −0.19 and −0.0018, λ₁ = 1.094 and 1.098 (effective mass 0.544 m and 0.542 m vs
+/// m₁ = 0.5423 m). Two elements along x (the unexcited direction): with one, every node lies
+/// on an end wall. In this 4 s run the default discretization's unstable modes (no lateral
+/// effective mass) did not show: on the quick mesh it gives RMS/peak 0.025 and f₁ = 1.4337 Hz
+/// (these settings: 0.040 and 1.4313 Hz), with a 20 Hz load ringing (liquid on the soft
+/// walls) during the pulse that the stiff walls remove; the stable settings are kept so that
+/// the comparison does not rest on a rest state that is unstable in linearization.
+/// Measured (release build, 2-core machine): quick 2×6×2, h ≤ 4 ms: RMS/peak 0.040,
+/// f₁ 1.4313 Hz, 7 s; full 2×8×3, h ≤ 2 ms: RMS/peak 0.012, f₁ 1.4372 Hz, 42 s.
+fn slosh_linear_potential_flow(quick: bool) -> Result<Vec<Record>> {
+    let c = "slosh-linear-potential-flow";
+    // rect_setup's tank: the excitation is along its width ly
+    let (ly, d) = (0.324, 0.132);
+    let (counts, h) = if quick { ([2, 6, 2], 0.004) } else { ([2, 8, 3], 0.002) };
+    let (t_a, t_b) = (0.5, 4.0);
+    let a = 0.03 * G;
+    let (t0, t1, ramp) = (0.1, 0.5, 0.02);
+    let samples = [(t0, 0.0), (t0 + ramp, a), (t1 - ramp, a), (t1, 0.0)];
+    let mut motion = PrescribedMotion::at_rest([0.0; 3]);
+    motion.translation[1] = PiecewiseAcceleration::new("pulse", &samples)?;
+    let (mesh, fluid, geo) = rect_setup(counts)?;
+    let wall_factor: f64 = 100.0;
+    let mut law = WallContactLaw::default_for(fluid.density, G, d);
+    law.stiffness *= wall_factor;
+    law.damping *= wall_factor.powf(1.5);
+    law.points_per_edge = 4;
+    let quad = QuadratureOptions { penalty: 4, ..QuadratureOptions::default() };
+    let (rec, mass) = run_with(mesh, fluid, geo, law, quad, motion, SloshFrame::Inertial, t_b, h)?;
+    let modes = super::linear_theory::RectangularTankModes::new(ly, d, mass, G, 50)?;
+    let n_grid = ((t_b - t_a) / 1e-3).round() as usize;
+    let grid: Vec<f64> = (0..=n_grid).map(|i| t_a + (t_b - t_a) * i as f64 / n_grid as f64).collect();
+    let f_ref = modes.force_history(&samples, &grid)?;
+    let f_ancf: Vec<f64> = resample(&rec.t, &|i| rec.force_tank[i], &grid).iter().map(|v| v[1]).collect();
+    let peak = f_ref.iter().fold(0.0, |m: f64, v| m.max(v.abs()));
+    let rms = (f_ref.iter().zip(&f_ancf).map(|(r, x)| (x - r).powi(2)).sum::<f64>() / grid.len() as f64).sqrt();
+    let peak_ancf = f_ancf.iter().fold(0.0, |m: f64, v| m.max(v.abs()));
+    let fy: Vec<f64> = rec.force_tank.iter().map(|f| f[1]).collect();
+    let f1 = zero_crossing_frequency(&rec.t, &fy, t_a, t_b);
+    let f1_modal = zero_crossing_frequency(&grid, &f_ref, t_a, t_b);
+    let f1_ref = modes.frequencies()[0];
+    let tag = format!(
+        "0.03 g lateral pulse 0.1-0.5 s (20 ms ramps), mesh {counts:?}, h <= {h} s, 4^3 penalty points, \
+         4x4 contact points, walls 100x stiffer"
+    );
+    Ok(vec![
+        Record::at_most(
+            c,
+            format!(
+                "RMS(F_y ANCF - F_y linear potential flow, 50 modes) over {t_a}-{t_b} s / peak |F_y| of the modal \
+                 solution ({peak:.3} N; ANCF peak {peak_ancf:.3} N), {tag}"
+            ),
+            rms / peak,
+            0.10,
+        ),
+        // A frequency error δ alone makes the two histories drift apart in phase by
+        // 2π δ f₁ t; for a pure first-mode response that is an RMS difference of about
+        // 14 δ of the peak over this window, so the RMS check above needs δ ≲ 0.7 %.
+        Record::abs(
+            c,
+            format!(
+                "first-mode frequency (Hz): zero crossings of the ANCF lateral load over {t_a}-{t_b} s (51 ms moving \
+                 average; the same estimator on the modal solution gives {f1_modal:.4} Hz) vs analytic 1.436 Hz, \
+                 tolerance 1 %, {tag}"
+            ),
+            f1,
+            f1_ref,
+            0.01 * f1_ref,
+        ),
+    ])
+}
+
+// DEVELOPMENT PROBE (to be replaced)
+fn env_f(name: &str, d: f64) -> f64 {
+    std::env::var(name).ok().and_then(|s| s.parse().ok()).unwrap_or(d)
+}
+
+fn zero_crossings_raw(t: &[f64], x: &[f64], ta: f64, tb: f64) -> (usize, f64) {
+    let i0 = t.iter().position(|&v| v >= ta).unwrap_or(t.len());
+    let mut c = Vec::new();
+    for i in i0..t.len().saturating_sub(1) {
+        if t[i + 1] > tb {
+            break;
+        }
+        let (a, b) = (x[i], x[i + 1]);
+        if a * b < 0.0 || (a == 0.0 && b != 0.0) {
+            c.push(t[i] + (t[i + 1] - t[i]) * a / (a - b));
+        }
+    }
+    if c.len() < 3 {
+        return (c.len(), f64::NAN);
+    }
+    (c.len(), (c.len() - 1) as f64 / (2.0 * (c[c.len() - 1] - c[0])))
+}
+
+fn slosh_load_convergence(_quick: bool) -> Result<Vec<Record>> {
+    let nx = env_f("LC_NX", 2.0) as usize;
+    let ny = env_f("LC_NY", 6.0) as usize;
+    let nz = env_f("LC_NZ", 2.0) as usize;
+    let h = env_f("LC_H", 0.004);
+    let pen = env_f("LC_PEN", 4.0) as usize;
+    let cpe = env_f("LC_CPE", 4.0) as usize;
+    let wall = env_f("LC_WALL", 100.0);
+    let dexp = env_f("LC_DEXP", 1.5);
+    let dmul = env_f("LC_DMUL", 1.0);
+    let t_end = env_f("LC_TEND", 4.0);
+    let (ta, tb) = (env_f("LC_TA", 0.7), t_end);
+    let counts = [nx, ny, nz];
+    let d = 0.132;
+    let mut motion = PrescribedMotion::at_rest([0.0; 3]);
+    motion.translation[1] = PiecewiseAcceleration::pulse(0.3 * G, 0.1, 0.6, 0.02)?;
+    let (mesh, fluid, geo) = rect_setup(counts)?;
+    let mut law = WallContactLaw::default_for(fluid.density, G, d);
+    law.stiffness *= wall;
+    law.damping *= wall.powf(dexp) * dmul;
+    law.points_per_edge = cpe;
+    let quad = QuadratureOptions { penalty: pen, ..QuadratureOptions::default() };
+    let tw = std::time::Instant::now();
+    let (rec, mass) = run_with(mesh, fluid, geo, law, quad, motion, SloshFrame::Inertial, t_end, h)?;
+    let fy: Vec<f64> = rec.force_tank.iter().map(|f| f[1]).collect();
+    let peak = rec.t.iter().zip(&fy).filter(|(t, _)| **t >= ta).map(|(_, v)| v.abs()).fold(0.0, f64::max);
+    let (nc, f_raw) = zero_crossings_raw(&rec.t, &fy, ta, tb);
+    let f_sm = zero_crossing_frequency(&rec.t, &fy, ta, tb);
+    let f_sp = dominant_frequency(&rec.t, &fy, ta, 0.3, 4.0);
+    let f_hi = dominant_frequency(&rec.t, &fy, ta, 4.0, 120.0);
+    let steps = rec.t.len();
+    let hmin = rec.t.windows(2).map(|w| w[1] - w[0]).fold(f64::INFINITY, f64::min);
+    let maxit = rec.newton_iterations.iter().max().copied().unwrap_or(0);
+    // residual of the smoothed signal: RMS of raw - 51 ms moving average, relative to peak
+    let n = ((tb - ta) / 1e-3).round() as usize;
+    let grid: Vec<f64> = (0..=n).map(|i| ta + (tb - ta) * i as f64 / n as f64).collect();
+    let y: Vec<f64> = resample(&rec.t, &|i| [fy[i], 0.0, 0.0], &grid).iter().map(|v| v[0]).collect();
+    let w = 25;
+    let mut hf = 0.0;
+    let mut cnt = 0;
+    for i in w..y.len() - w {
+        let m = y[i - w..=i + w].iter().sum::<f64>() / (2 * w + 1) as f64;
+        hf += (y[i] - m).powi(2);
+        cnt += 1;
+    }
+    let hf = (hf / cnt as f64).sqrt();
+    let msg = format!(
+        "PROBE mesh {counts:?} h {h} pen {pen} cpe {cpe} wall {wall} dexp {dexp} dmul {dmul}: peak/(m.3g) {:.4} \
+         peakN {peak:.3} f_raw {f_raw:.4} (n {nc}) f_sm {f_sm:.4} f_sp {f_sp:.4} f_hi {f_hi:.2} hfRMS/peak {:.4} steps {steps} hmin {hmin:.2e} maxit {maxit} wall {:.1}s",
+        peak / (mass * 0.3 * G),
+        hf / peak,
+        tw.elapsed().as_secs_f64()
+    );
+    eprintln!("{msg}");
+    if std::env::var("LC_DUMP").is_ok() {
+        let s: String = rec.t.iter().zip(&fy).map(|(t, f)| format!("{t} {f}\n")).collect();
+        std::fs::write(std::env::var("LC_DUMP").unwrap(), s).ok();
+    }
+    Ok(vec![Record::at_most("slosh-load-convergence", msg, 0.0, 1.0)])
 }

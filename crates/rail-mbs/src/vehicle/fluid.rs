@@ -32,6 +32,7 @@ use ancf_core::shape::N_SHAPE;
 use nalgebra::{Matrix3, Vector3};
 
 use crate::integrator::{KktIndex, MechanicalSystem, SparsityPattern, SystemError};
+use crate::invariants::{EnergySample, InvariantLimits, InvariantMonitor, Margins, Pending, stored_energy, wall_power};
 use crate::mbs::{BodyId, BodyState, Multibody};
 
 /// Finite-difference steps for the tank coordinates and velocities.
@@ -83,6 +84,11 @@ pub struct FluidVehicle {
     /// Contact-force buffers of the step check and the finite differences (fluid length;
     /// zeroed before each use: the contact adds into them).
     scratch: [Vec<f64>; 2],
+    /// The run-time invariants of each fluid: containment, element validity and energy
+    /// balance (issue 16), accounted over the accepted steps.
+    monitors: Vec<InvariantMonitor>,
+    /// Each fluid's assessed state in the step being checked (committed once all pass).
+    pending: Vec<Option<Pending>>,
 }
 
 fn sys_err(e: AncfError) -> SystemError {
@@ -124,10 +130,37 @@ impl FluidVehicle {
             workspaces,
             jacobians: Vec::new(),
             scratch: Default::default(),
+            monitors: Vec::new(),
+            pending: Vec::new(),
         };
+        let g = s.mb.gravity.norm();
+        s.monitors = (0..s.fluids.len())
+            .map(|k| {
+                let body = &s.fluids[k].body;
+                let depth =
+                    body.mesh.free_surface_z - body.mesh.nodes.iter().map(|n| n[2]).fold(f64::INFINITY, f64::min);
+                let limits = InvariantLimits::new(s.penetration_limit(k));
+                InvariantMonitor::new(format!("fluid {k}"), limits, body.total_mass(), g, depth.max(0.0))
+            })
+            .collect();
+        s.pending = vec![None; s.fluids.len()];
         let (_, layouts) = s.build_pattern();
         s.layouts = layouts;
         Ok(s)
+    }
+
+    /// Worst invariant margins over every fluid and accepted step so far.
+    pub fn margins(&self) -> Margins {
+        self.monitors.iter().map(|m| m.margins()).fold(Margins::default(), Margins::worst)
+    }
+
+    /// Largest admissible penetration of fluid `k` (m): [`PENETRATION_LIMIT_FACTOR`] × its
+    /// smallest element edge, as in `SloshSystem`.
+    ///
+    /// [`PENETRATION_LIMIT_FACTOR`]: crate::slosh::system::PENETRATION_LIMIT_FACTOR
+    fn penetration_limit(&self, k: usize) -> f64 {
+        let min_edge = self.fluids[k].body.elements.iter().flat_map(|el| el.lengths).fold(f64::INFINITY, f64::min);
+        crate::slosh::system::PENETRATION_LIMIT_FACTOR * min_edge
     }
 
     fn build_pattern(&self) -> (SparsityPattern, Vec<FluidLayout>) {
@@ -314,11 +347,17 @@ impl MechanicalSystem for FluidVehicle {
     }
 
     /// Rejects a step on which a fluid's volume error exceeds 1 % or a fluid penetrates
-    /// its tank wall deeper than half its smallest element edge (as `SloshSystem`).
-    fn check_step(&mut self, _t: f64, q: &[f64], v: &[f64]) -> Result<(), SystemError> {
+    /// its tank wall deeper than half its smallest element edge (as `SloshSystem`), or
+    /// breaks a run-time invariant ([`crate::invariants`]): a node, contact point or the
+    /// centre of mass beyond the wall by more than the same limit, a volume ratio at or
+    /// below [`crate::invariants::MIN_VOLUME_RATIO`], or energy growth beyond what the
+    /// tank walls put in (the liquid's energy in the global frame, the walls' work from
+    /// the tank body's velocities). A step is accounted only when every fluid passes.
+    fn check_step(&mut self, t: f64, q: &[f64], v: &[f64]) -> Result<(), SystemError> {
         let nr = self.n_rigid;
-        let [scratch, _] = &mut self.scratch;
-        for (k, f) in self.fluids.iter().enumerate() {
+        let g = self.mb.gravity;
+        for k in 0..self.fluids.len() {
+            let f = &self.fluids[k];
             let o = self.layouts[k].offset;
             let (e, ed) = (&q[o..o + f.body.n_coords()], &v[o..o + f.body.n_coords()]);
             let (volume, reference) = (f.body.volume(e), f.body.reference_volume());
@@ -327,18 +366,33 @@ impl MechanicalSystem for FluidVehicle {
                 return Err(SystemError::VolumeError { what: format!("fluid {k}"), volume, reference, limit: 0.01 });
             }
             let tank = self.mb.state(Some(f.tank), &q[..nr], &v[..nr]);
+            let kin = tank_kinematics(&tank);
             // The contact adds its forces into the buffer.
+            let scratch = &mut self.scratch[0];
             scratch.clear();
             scratch.resize(e.len(), 0.0);
-            let load = f.contact.forces(&f.body, &tank_kinematics(&tank), e, ed, scratch, None);
-            let min_edge = f.body.elements.iter().flat_map(|el| el.lengths).fold(f64::INFINITY, f64::min);
-            let limit = crate::slosh::system::PENETRATION_LIMIT_FACTOR * min_edge;
+            let load = f.contact.forces(&f.body, &kin, e, ed, scratch, None);
+            let limit = self.monitors[k].limits.containment;
             if load.max_penetration > limit {
                 return Err(SystemError::Penetration {
                     contact: format!("fluid {k} - tank wall ({} points active)", load.active),
                     depth: load.max_penetration,
                     limit,
                 });
+            }
+            let energy = EnergySample {
+                kinetic: f.body.kinetic_energy(ed),
+                potential: f.body.potential_energy(e, g.into()),
+                stored: stored_energy(&f.body, &f.contact, &kin, e),
+                input_power: wall_power(load.force, load.moment, &kin),
+            };
+            let assessed = self.monitors[k].assess(t, &f.body, &f.contact, &kin, e, energy);
+            self.pending[k] = Some(assessed.map_err(|(error, _, _)| error)?);
+        }
+        // every fluid passed: the step is accepted
+        for (m, p) in self.monitors.iter_mut().zip(self.pending.iter_mut()) {
+            if let Some(p) = p.take() {
+                m.commit(p);
             }
         }
         Ok(())
@@ -562,6 +616,8 @@ pub struct FluidTrainRecord {
     /// Element-node table of each car's fluid mesh (node order A..H, docs/frames.md), for
     /// writing the snapshots as hexahedra.
     pub connectivity: Vec<[usize; 8]>,
+    /// Worst invariant margins over every car's fluid ([`FluidVehicle::margins`]).
+    pub margins: Margins,
 }
 
 impl FluidTrainRecord {
@@ -704,6 +760,9 @@ pub fn run_fluid_train_streamed(
     let start = Instant::now();
     let finish = |hht: Option<&Hht<FluidVehicle>>, mut rec: FluidTrainRecord| {
         rec.train.finish(hht.map(|h| h.stats()), start);
+        if let Some(h) = hht {
+            rec.margins = h.system().margins();
+        }
         rec
     };
     let mut hht = match Hht::new(sys, 0.0, q0, v0, sc.hht) {

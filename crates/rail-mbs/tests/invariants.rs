@@ -1,0 +1,175 @@
+//! Run-time invariants of slosh runs (issue 16): containment, energy balance, element
+//! validity. Each failing setup must stop with its typed, located error and keep what
+//! it computed; a healthy run must report margins that say so.
+
+use ancf_core::FluidBody;
+use ancf_core::constitutive::Rheology;
+use ancf_core::contact::{WallContact, WallContactLaw};
+use ancf_core::element::QuadratureOptions;
+use ancf_core::mesh::box_mesh;
+use ancf_core::tank::{TankGeometry, TankShape};
+use rail_mbs::integrator::{FailureCause, IntegratorError, SystemError};
+use rail_mbs::slosh::validate::{liquid, slosh_params};
+use rail_mbs::slosh::{PiecewiseAcceleration, PrescribedMotion, SloshFrame, SloshRun, SloshSystem};
+
+const G: f64 = 9.81;
+const RHO: f64 = 998.0;
+// seed 003's rectangular tank: 0.416 × 0.324 m, water 0.132 m deep
+const L: [f64; 3] = [0.416, 0.324, 0.132];
+
+/// Water in the seed-003 box tank on a 2×4×2 mesh (4³ force rules, which keep the rest
+/// state of this mesh stable), with `law` adjusted by `adjust`, and a lateral pulse of
+/// `pulse` m/s² on [0.05, 0.45] s.
+fn box_run(frame: SloshFrame, pulse: f64, adjust: impl FnOnce(&mut WallContactLaw)) -> SloshRun {
+    let lo = [-0.5 * L[0], -0.5 * L[1], 0.0];
+    let mesh = box_mesh(lo, L, [2, 4, 2]).unwrap();
+    let fluid = liquid(RHO, Rheology::Newtonian { viscosity: 1e-3 }, L[2], L[2] / 2.0).unwrap();
+    let body = FluidBody::new(mesh, fluid, QuadratureOptions { viscous: 4, penalty: 4, mass: 4 }).unwrap();
+    let geo = TankGeometry::new(TankShape::Box { min: lo, max: [0.5 * L[0], 0.5 * L[1], 0.3] }, vec![]).unwrap();
+    let mut law = WallContactLaw::default_for(RHO, G, L[2]);
+    adjust(&mut law);
+    let contact = WallContact::new(&body, geo, law).unwrap();
+    let mut motion = PrescribedMotion::at_rest([0.0; 3]);
+    if pulse != 0.0 {
+        motion.translation[1] = PiecewiseAcceleration::pulse(pulse, 0.05, 0.45, 0.02).unwrap();
+    }
+    let sys = SloshSystem::new(body, contact, motion, [0.0, 0.0, -G], frame).unwrap();
+    SloshRun::new(sys, 0.0, slosh_params()).unwrap()
+}
+
+#[test]
+fn a_dissipative_slosh_run_balances_its_energy_in_both_frames() {
+    let mut dissipated = Vec::new();
+    for frame in [SloshFrame::Inertial, SloshFrame::Tank] {
+        let mut run = box_run(frame, 0.3 * G, |_| {});
+        run.run_to(1.0, 0.005).unwrap();
+        let m = run.margins();
+        let r = &run.record;
+        // the pulse put work in, and the liquid moved
+        let w = *r.input_work.last().unwrap();
+        assert!(r.input_work.iter().any(|x| x.abs() > 0.1), "{frame:?}: no work put in: {w}");
+        // E = E0 + W − D with D ≥ 0: the growth ε never exceeds round-off and step error
+        assert!(m.worst_energy_error < 1e-3, "{frame:?}: ε = {}", m.worst_energy_error);
+        assert!(m.dissipated > 0.0, "{frame:?}: dissipated {}", m.dissipated);
+        // nodes are not contact points (Gauss points are): they may sit a few mm in the wall
+        assert!(m.worst_gap < 0.25 * run.invariants.limits.containment, "{frame:?}: {m:?}");
+        assert!(m.min_volume_ratio > 0.9, "{frame:?}: {m:?}");
+        assert_eq!(r.energy_error.len(), r.t.len());
+        dissipated.push(m.dissipated);
+    }
+    // the two formulations account the same physics: the same energy dissipated (the
+    // tank-frame one measures it relative to the tank, which moves at constant velocity
+    // after the pulse: the kinetic energy of the relative motion is the same)
+    let rel = (dissipated[0] - dissipated[1]).abs() / dissipated[0].abs().max(dissipated[1].abs());
+    assert!(rel < 0.05, "dissipated energy inertial {} vs tank frame {}", dissipated[0], dissipated[1]);
+}
+
+#[test]
+fn negative_contact_damping_injects_energy_and_stops_with_the_energy_error() {
+    // A Hunt–Crossley wall with c < 0 pushes harder on rebound than on impact: each bounce
+    // creates energy. (The law's validation refuses c < 0; this sets it past that, as a
+    // defect in a contact model would.)
+    let mut run = box_run(SloshFrame::Inertial, 0.3 * G, |_| {});
+    run.hht.system_mut().contact.law.damping *= -20.0;
+    let err = run.run_to(2.0, 0.005).expect_err("energy creation must stop the run");
+    assert_eq!(err.error.cause(), FailureCause::EnergyGrowth, "{}", err.error);
+    let IntegratorError::System { t, source: SystemError::EnergyGrowth { relative, limit, .. } } = err.error.root()
+    else {
+        panic!("{}", err.error)
+    };
+    assert!(*relative > *limit && *t > 0.0 && *t < 2.0, "{}", err.error);
+    // everything computed is kept, up to and including the violating sample
+    assert_eq!(err.record.t.last(), Some(t));
+    assert!(err.record.energy_error.iter().rev().skip(1).all(|e| *e <= *limit));
+}
+
+#[test]
+fn leaky_walls_stop_with_the_containment_error_naming_the_site() {
+    // walls 1000× too soft: the liquid sinks through the floor
+    let mut run = box_run(SloshFrame::Inertial, 0.0, |law| {
+        law.stiffness *= 1e-3;
+        law.damping *= 1e-3f64.powf(1.5);
+    });
+    // the per-step penetration guard of the contact points is disabled, so that only the
+    // run-time invariant can stop the run
+    run.hht.system_mut().penetration_limit = f64::INFINITY;
+    let limit = run.invariants.limits.containment;
+    assert!(limit.is_finite() && limit > 0.0);
+    let err = run.run_to(2.0, 0.005).expect_err("a liquid falling through its tank must stop the run");
+    assert_eq!(err.error.cause(), FailureCause::Containment, "{}", err.error);
+    let msg = err.error.to_string();
+    assert!(msg.contains("not contained") && msg.contains("beyond the wall"), "{msg}");
+    let IntegratorError::System { source: SystemError::Containment { depth, position, .. }, .. } = err.error.root()
+    else {
+        panic!("{msg}")
+    };
+    assert!(*depth > limit && position[2] < 0.0, "{msg}");
+    assert!(err.record.containment_gap.last().unwrap() > &limit);
+}
+
+#[test]
+fn a_liquid_at_rest_stays_at_rest_with_flat_energy() {
+    let mut run = box_run(SloshFrame::Inertial, 0.0, |_| {});
+    run.run_to(2.0, 0.01).unwrap();
+    let r = &run.record;
+    let half = r.t.iter().position(|t| *t >= 1.0).unwrap();
+    let peak = |k: &[f64]| k.iter().fold(0.0f64, |m, x| m.max(*x));
+    let (early, late) = (peak(&r.kinetic_energy[..half]), peak(&r.kinetic_energy[half..]));
+    let m = run.margins();
+    let mgh = run.hht.system().body.total_mass() * G * L[2];
+    // the settling of the penalty pressure is the only motion, and it decays
+    assert!(early < 1e-3 * mgh, "kinetic energy while settling {early} J (m g H = {mgh} J)");
+    assert!(late < 0.5 * early, "kinetic energy at rest does not decay: {early} J, then {late} J");
+    assert!(m.worst_energy_error.abs() < 1e-4, "{m:?}");
+    assert!(m.worst_gap < 3e-3 * L[2], "{m:?}");
+}
+
+/// λ_min = ω²_min H/g of the SwRI tank (seed 003) on the shipped scenes' 1×2×2 mesh, about
+/// its rest state settled by dynamic relaxation (viscosity 10⁴ Pa·s, 3 s), with the force
+/// points per direction `np` and contact points per face edge `ppe`.
+fn swri_rest_lambda_min(np: usize, ppe: usize, walls: f64) -> f64 {
+    use ancf_core::mesh::{EllipticCylinderSpec, elliptic_cylinder};
+    use rail_mbs::slosh::linear_modes;
+    let spec = EllipticCylinderSpec::swri(1, 2, 2);
+    let mesh = elliptic_cylinder(&spec).unwrap();
+    let depth = mesh.free_surface_z - mesh.nodes.iter().map(|n| n[2]).fold(f64::INFINITY, f64::min);
+    let mut fluid = liquid(RHO, Rheology::Newtonian { viscosity: 1e-3 }, depth, depth / 2.0).unwrap();
+    fluid.rheology = Rheology::Newtonian { viscosity: 1e4 };
+    let body = FluidBody::new(mesh, fluid, QuadratureOptions { viscous: np, penalty: np, mass: 4 }).unwrap();
+    let geo = TankGeometry::new(
+        TankShape::EllipticCylinder {
+            length: spec.length,
+            semi_axis_y: spec.semi_axis_y,
+            semi_axis_z: spec.semi_axis_z,
+        },
+        vec![],
+    )
+    .unwrap();
+    let mut law = WallContactLaw { points_per_edge: ppe, ..WallContactLaw::default_for(RHO, G, depth) };
+    law.stiffness *= walls;
+    law.damping *= walls.powf(1.5);
+    let contact = WallContact::new(&body, geo, law).unwrap();
+    let sys =
+        SloshSystem::new(body, contact, PrescribedMotion::at_rest([0.0; 3]), [0.0, 0.0, -G], SloshFrame::Inertial)
+            .unwrap();
+    let mut run = SloshRun::new(sys, 0.0, slosh_params()).unwrap();
+    run.run_to(3.0, 0.02).unwrap();
+    let q = run.hht.q().to_vec();
+    let mut sys = run.hht.into_system();
+    let modes = linear_modes(&mut sys, 3.0, &q).unwrap();
+    modes.omega_sq[0] * depth / G
+}
+
+/// Measured (release): λ_min = −2.83 with the library's 3³ force points and 3×3 contact
+/// points (growth √(−λ g/H) = 14.5 1/s), −0.0173 with the shipped scenes' 4³ and 5×5 (1.1 1/s);
+/// 4³ 4×4: −0.0145, 5³ 5×5: −0.0172, 4³ 6×6: −0.0159; stiffer walls make it worse here
+/// (4³ 5×5 with walls ×10: −0.087, ×100: −0.228). The shipped settings remove 99 % of the
+/// instability but not all of it (a stable rest state would be λ_min ≥ −0.01): open, see
+/// docs/validation.md "Known gaps". This test keeps what was gained from regressing.
+#[test]
+fn the_shipped_swri_settings_remove_most_of_the_rest_state_instability() {
+    let shipped = swri_rest_lambda_min(4, 5, 1.0);
+    let default = swri_rest_lambda_min(3, 3, 1.0);
+    assert!(default < -1.0, "the default discretization was measured at -2.83: {default}");
+    assert!(shipped > -0.02 && shipped > 0.01 * default, "shipped settings: lambda_min = {shipped}");
+}

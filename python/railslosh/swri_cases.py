@@ -1,0 +1,131 @@
+"""Validation case ``swri-maneuvers`` (issue 16 §4): the six SwRI manoeuvre scenes of seed 003
+(``examples/scenes/swri_*.toml``: lane changes at 20 and 40 mph, half-round and trapezoidal bumps)
+run to their planned end with the liquid contained and its energy balanced, and (full form)
+their peak loads converge under mesh refinement.
+
+The scenes are read from the repository's ``examples/scenes`` (found next to the package or from
+the current directory); without them the case is skipped, like the cases that need shared data.
+Quick form (CI): each scene shortened to 1.5 s, past the time at which the liquid of the
+2026-11-24 main had left its tank. Full form: each scene to its end on its shipped mesh and on a
+mesh refined twice along each direction, with the peak loads compared.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+import numpy as np
+
+SCENES = (
+    "swri_lane_change_20mph",
+    "swri_lane_change_40mph",
+    "swri_bump_half_round_9in_10mph",
+    "swri_bump_half_round_12in_5mph",
+    "swri_bump_trapezoid_9in_15mph",
+    "swri_bump_trapezoid_12in_10mph",
+)
+#: Largest admissible energy growth (rail_mbs::invariants::ENERGY_GROWTH_LIMIT).
+ENERGY_LIMIT = 0.05
+#: Peak-load change between the shipped and the refined mesh (issue 16 §4).
+CONVERGENCE_TOLERANCE = 0.05
+QUICK_T_END = 1.5
+
+
+def _record(case: str, quantity: str, measured: float, reference: float, tolerance: float, passed: bool) -> dict:
+    return {
+        "case": case,
+        "quantity": quantity,
+        "measured": float(measured),
+        "reference": float(reference),
+        "tolerance": float(tolerance),
+        "passed": bool(passed),
+    }
+
+
+def _run(sc: Any) -> tuple[dict, str | None]:
+    from railslosh import scene, slosh
+
+    try:
+        return scene.run_scene(sc), None
+    except slosh.SimulationError as exc:
+        return exc.results, str(exc)
+
+
+def _containment_limit(sc: Any) -> float:
+    """Half the smallest element edge of the scene's mesh (the runs' penetration limit)."""
+    length, a, _ = sc.tank.dims
+    nl, nw, nh = sc.fluid.counts
+    return 0.5 * min(length / nl, 2.0 * a / nw, sc.depth() / nh)
+
+
+def _peak_load(res: dict) -> float:
+    """Largest |force of the liquid on the tank| after the manoeuvre starts (t > 0.2 s: the first
+    0.2 s are the settling of the penalty pressure, not a load of the manoeuvre)."""
+    t = np.asarray(res["t"])
+    f = np.linalg.norm(np.asarray(res["force_tank"]), axis=1)
+    keep = t > 0.2
+    return float(f[keep].max()) if keep.any() else float("nan")
+
+
+def swri_maneuvers(quick: bool) -> list[dict]:
+    from railslosh import scene
+    from railslosh.stress import _scenes_dir
+    from railslosh.validate import CaseSkipped
+
+    case = "swri-maneuvers"
+    d = _scenes_dir()
+    if d is None:
+        raise CaseSkipped(f"{case}: skipped: examples/scenes not found (run from the repository)")
+    out = []
+    for name in SCENES:
+        sc = scene.load_scene(d / f"{name}.toml")
+        if quick:
+            sc = dataclasses.replace(sc, t_end=min(sc.t_end, QUICK_T_END))
+        res, err = _run(sc)
+        t_reached = float(res["t"][-1]) if len(res["t"]) else 0.0
+        m = res.get("margins") or {}
+        limit = _containment_limit(sc)
+        what = f"{name} ({'x'.join(map(str, sc.fluid.counts))} mesh, t_end {sc.t_end:g} s)"
+        out.append(
+            _record(
+                case,
+                f"{what}: time reached (s){'; stopped: ' + err if err else ''}",
+                t_reached,
+                sc.t_end,
+                1e-9,
+                err is None and abs(t_reached - sc.t_end) <= 1e-9 * (1 + sc.t_end),
+            )
+        )
+        gap = float(m.get("worst_gap", float("nan")))
+        out.append(_record(case, f"{what}: worst containment gap (m), limit half the smallest edge", gap, 0.0, limit, gap <= limit))
+        eps = m.get("worst_energy_error")
+        eps = float("nan") if eps is None else float(eps)
+        out.append(_record(case, f"{what}: energy growth (E - E0 - W)/E_ref", eps, 0.0, ENERGY_LIMIT, eps <= ENERGY_LIMIT))
+        if quick:
+            continue
+        fine = dataclasses.replace(sc, fluid=dataclasses.replace(sc.fluid, counts=tuple(2 * n for n in sc.fluid.counts)))
+        res_fine, err_fine = _run(fine)
+        peak, peak_fine = _peak_load(res), _peak_load(res_fine)
+        change = abs(peak_fine - peak) / peak_fine if peak_fine > 0 else float("nan")
+        out.append(
+            _record(
+                case,
+                f"{what}: peak |load on the tank| after 0.2 s, change to the {'x'.join(map(str, fine.fluid.counts))} mesh "
+                f"(peaks {peak:.1f} N and {peak_fine:.1f} N{'; refined run stopped: ' + err_fine if err_fine else ''})",
+                change,
+                0.0,
+                CONVERGENCE_TOLERANCE,
+                err_fine is None and change <= CONVERGENCE_TOLERANCE,
+            )
+        )
+    return out
+
+
+SWRI_CASES = {
+    "swri-maneuvers": (
+        "the six SwRI manoeuvre scenes (lane changes 20/40 mph, half-round and trapezoid bumps) run to their end "
+        "with the liquid contained and energy balanced; full form: peak loads converged to 5 % under mesh refinement",
+        swri_maneuvers,
+    )
+}
