@@ -77,7 +77,13 @@ VARIABLES: dict[str, tuple[tuple[str, ...], str, str, str, dict[str, str]]] = {
     ),
     "energy_error": ((), "1", "", "energy growth (E - E0 - input work) / energy scale; <= 0 when physical", {}),
     "min_volume_ratio": ((), "1", "", "smallest volume ratio J = det F at any quadrature point", {}),
-    "containment_gap": ((), "m", "tank", "largest gap beyond a wall of any fluid node, contact point or the centre of mass", {}),
+    "containment_gap": (
+        (),
+        "m",
+        "tank",
+        "largest gap beyond a wall of any fluid node, contact point or the centre of mass",
+        {},
+    ),
 }
 
 _SCALARS = ("static_wheel_load", "dof", "fluid_mass", "elements")

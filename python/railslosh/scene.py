@@ -840,9 +840,10 @@ class SloshScene:
     fluids). ``[mesh]``: ``counts``; ``viscous_points`` and ``penalty_points`` (Gauss points per
     direction of the viscous stress, 3-6, and of the volumetric penalty, 2-6; default 3) and
     ``contact_points_per_edge`` (wall-contact points per face edge, 2-6, default 3): coarse meshes
-    under violent maneuvers need 4 (docs/validation.md, "Run-time invariants"). ``[solver]``: ``t_end`` (s), ``step`` (s), ``frame``
-    (``"inertial"`` or ``"tank"``), ``contact_stiffness_factor`` (wall stiffness as a multiple of the
-    default penalty law, 0.1 to 1000). ``[outputs]``: ``netcdf``, ``plots``.
+    under violent maneuvers need more (the SwRI scenes use 4, 4, 5: docs/validation.md, "Run-time
+    invariants"). ``[solver]``:
+    ``t_end`` (s), ``step`` (s), ``frame`` (``"inertial"`` or ``"tank"``), ``contact_stiffness_factor``
+    (wall stiffness as a multiple of the default penalty law, 0.1 to 1000). ``[outputs]``: ``netcdf``, ``plots``.
     ``[maneuver]``: ``type`` =
 
     * ``"lane_change"``: lateral (y) displacement ``offset`` (m, default 3.66 = 12 ft) over ``length``

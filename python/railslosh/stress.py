@@ -179,7 +179,9 @@ def cases(form: str = "quick") -> list[Case]:
         # rheology under a 1 g lateral load
         for mu in (1e-3, 1.0, 1e2):
             for tau in (0.0, 10.0, 1e3):
-                out.append(_slosh("rheology_1g", f"mu={mu},tau={tau}", viscosity=mu, yield_stress=tau, accel=(0.0, G, 0.0)))
+                out.append(
+                    _slosh("rheology_1g", f"mu={mu},tau={tau}", viscosity=mu, yield_stress=tau, accel=(0.0, G, 0.0))
+                )
         # quadrature and contact points
         for vp in (3, 4, 5, 6):
             for cp in (2, 4, 6):

@@ -98,20 +98,29 @@ def swri_maneuvers(quick: bool) -> list[dict]:
             )
         )
         gap = float(m.get("worst_gap", float("nan")))
-        out.append(_record(case, f"{what}: worst containment gap (m), limit half the smallest edge", gap, 0.0, limit, gap <= limit))
+        out.append(
+            _record(
+                case, f"{what}: worst containment gap (m), limit half the smallest edge", gap, 0.0, limit, gap <= limit
+            )
+        )
         eps = m.get("worst_energy_error")
         eps = float("nan") if eps is None else float(eps)
-        out.append(_record(case, f"{what}: energy growth (E - E0 - W)/E_ref", eps, 0.0, ENERGY_LIMIT, eps <= ENERGY_LIMIT))
+        out.append(
+            _record(case, f"{what}: energy growth (E - E0 - W)/E_ref", eps, 0.0, ENERGY_LIMIT, eps <= ENERGY_LIMIT)
+        )
         if quick:
             continue
-        fine = dataclasses.replace(sc, fluid=dataclasses.replace(sc.fluid, counts=tuple(2 * n for n in sc.fluid.counts)))
+        fine = dataclasses.replace(
+            sc, fluid=dataclasses.replace(sc.fluid, counts=tuple(2 * n for n in sc.fluid.counts))
+        )
         res_fine, err_fine = _run(fine)
         peak, peak_fine = _peak_load(res), _peak_load(res_fine)
         change = abs(peak_fine - peak) / peak_fine if peak_fine > 0 else float("nan")
         out.append(
             _record(
                 case,
-                f"{what}: peak |load on the tank| after 0.2 s, change to the {'x'.join(map(str, fine.fluid.counts))} mesh "
+                f"{what}: peak |load on the tank| after 0.2 s, change to the "
+                f"{'x'.join(map(str, fine.fluid.counts))} mesh "
                 f"(peaks {peak:.1f} N and {peak_fine:.1f} N{'; refined run stopped: ' + err_fine if err_fine else ''})",
                 change,
                 0.0,

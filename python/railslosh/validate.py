@@ -68,6 +68,9 @@ _DESCRIPTIONS = {
     "slosh-linear-potential-flow": "seed 003 rectangular tank, 0.03 g lateral pulse (linear regime): lateral load "
     "history vs the 50-mode linear potential-flow solution, RMS difference over 0.5-4 s <= 10 % of its peak; "
     "first-mode frequency from zero crossings vs 1.436 Hz",
+    "slosh-load-convergence": "seed 003 rectangular tank, 0.3 g lateral pulse: peak lateral load after the pulse and "
+    "f1 from zero crossings of the raw load change <= 5 % between the two finest of three meshes and two step sizes; "
+    "raw zero-crossing frequency within 3 % of the spectral peak (no chatter)",
     "manchester-contact-left": "Manchester contact benchmark A2.2, left wheel (S1002 on UIC60 1:40, 10 kN, shifts "
     "0-10 mm) vs CONTACT: contact position, normal force, creep forces (needs shared data)",
     "static-wheel-loads": "68-DOF tank car (36 t rigid lading) settles on tangent track: every wheel load equals "
@@ -84,6 +87,8 @@ _DESCRIPTIONS = {
     "curve-outward-inertia": "one car on the Table 1 curve at 60 and 100 km/h: outward inertia force of the oil vs the "
     "in-plane gravity component, growing with density",
     "mesh-convergence": "one car braking with light crude on three meshes: oil centre-of-mass trajectories agree",
+    "coupler-force-convergence": "two cars braking (ECP and conventional) with light crude: peak of the low-passed "
+    "coupler force, its RMS and steady mean change <= 5 % between the two finest of three meshes and two steps",
     "klingel-wavelength": "kinematic (no-slip) free coned wheelset: lateral oscillation wavelength vs Klingel's "
     "2 pi sqrt(r0 b / lambda)",
 }

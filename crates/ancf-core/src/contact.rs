@@ -427,12 +427,7 @@ impl WallContact {
             consider(FluidSite::Node(n), Vector3::new(e[g], e[g + 1], e[g + 2]), sides);
         }
         for (k, pt) in self.points.iter().enumerate() {
-            let nodes = &body.mesh.elements[pt.element];
-            let mut r = Vector3::zeros();
-            for a in 0..N_SHAPE {
-                let g = 3 * (4 * nodes[a / 4] + a % 4);
-                r += pt.shape[a] * Vector3::new(e[g], e[g + 1], e[g + 2]);
-            }
+            let r = self.point_position(body, k, e);
             consider(FluidSite::ContactPoint { point: k, element: pt.element }, r, &pt.sides);
         }
         consider(FluidSite::CentreOfMass, Vector3::from(body.center_of_mass(e)), &[]);
@@ -445,19 +440,23 @@ impl WallContact {
         let at = kin.rotation.transpose();
         let rt = Vector3::from(kin.position);
         let mut u = 0.0;
-        for pt in &self.points {
-            let nodes = &body.mesh.elements[pt.element];
-            let mut r = Vector3::zeros();
-            for a in 0..N_SHAPE {
-                let g = 3 * (4 * nodes[a / 4] + a % 4);
-                r += pt.shape[a] * Vector3::new(e[g], e[g + 1], e[g + 2]);
-            }
-            let p = at * (r - rt);
+        for (k, pt) in self.points.iter().enumerate() {
+            let p = at * (self.point_position(body, k, e) - rt);
             self.geometry.for_each_hit_with([p[0], p[1], p[2]], &pt.sides, false, |h| {
                 u += 0.5 * pt.weight * self.law.stiffness * h.psi * h.psi;
             });
         }
         u
+    }
+
+    /// Position of contact point `k` (global).
+    fn point_position(&self, body: &FluidBody, k: usize, e: &[f64]) -> Vector3<f64> {
+        let pt = &self.points[k];
+        let nodes = &body.mesh.elements[pt.element];
+        (0..N_SHAPE).fold(Vector3::zeros(), |r, a| {
+            let g = 3 * (4 * nodes[a / 4] + a % 4);
+            r + pt.shape[a] * Vector3::new(e[g], e[g + 1], e[g + 2])
+        })
     }
 
     /// Position and velocity of a contact point (global).
@@ -1038,14 +1037,7 @@ mod tests {
         assert!((area - 2.0 * (0.6 * 0.4 + 0.6 * 0.3 + 0.4 * 0.3)).abs() < 1e-12);
         // every node on the boundary is a contact point (Gauss points never are)
         let e = body.reference_coordinates();
-        let at = |k: usize| {
-            let nodes = &body.mesh.elements[c.points[k].element];
-            (0..N_SHAPE).fold(Vector3::zeros(), |r, a| {
-                let g = 3 * (4 * nodes[a / 4] + a % 4);
-                r + c.points[k].shape[a] * Vector3::new(e[g], e[g + 1], e[g + 2])
-            })
-        };
-        let pts: Vec<Vector3<f64>> = (0..c.points.len()).map(at).collect();
+        let pts: Vec<Vector3<f64>> = (0..c.points.len()).map(|k| c.point_position(&body, k, &e)).collect();
         let on_boundary =
             |p: &[f64; 12]| (0..3).any(|d| p[d].abs() < 1e-12 || (p[d] - [0.6, 0.4, 0.3][d]).abs() < 1e-12);
         for n in body.mesh.nodes.iter().filter(|n| on_boundary(n)) {
@@ -1054,14 +1046,7 @@ mod tests {
         }
         let gauss = WallContact::new(&body, geo, WallContactLaw::default_for(1000.0, 9.81, 0.3)).unwrap();
         let corner = Vector3::zeros();
-        assert!((0..gauss.points.len()).all(|k| {
-            let nodes = &body.mesh.elements[gauss.points[k].element];
-            let r = (0..N_SHAPE).fold(Vector3::zeros(), |r, a| {
-                let g = 3 * (4 * nodes[a / 4] + a % 4);
-                r + gauss.points[k].shape[a] * Vector3::new(e[g], e[g + 1], e[g + 2])
-            });
-            (r - corner).norm() > 1e-3
-        }));
+        assert!((0..gauss.points.len()).all(|k| (gauss.point_position(&body, k, &e) - corner).norm() > 1e-3));
         // one point per edge cannot hold both edges
         let one = WallContactLaw { points_per_edge: 1, ..law };
         assert!(one.validate().unwrap_err().to_string().contains("contact.points_per_edge"));

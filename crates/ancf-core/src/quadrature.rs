@@ -5,6 +5,18 @@ use crate::error::{Result, invalid};
 /// Largest number of Gauss points per direction supported.
 pub const MAX_GAUSS_POINTS: usize = 8;
 
+/// (P_n(z), P_{n−1}(z)) by the three-term recurrence (n ≥ 1).
+fn legendre(n: usize, z: f64) -> (f64, f64) {
+    let (mut p0, mut p1) = (1.0, z);
+    for k in 2..=n {
+        let kf = k as f64;
+        let p2 = ((2.0 * kf - 1.0) * z * p1 - (kf - 1.0) * p0) / kf;
+        p0 = p1;
+        p1 = p2;
+    }
+    (p1, p0)
+}
+
 /// Nodes and weights of the `n`-point Gauss–Legendre rule on [-1, 1],
 /// computed by Newton iteration on the Legendre polynomial (exact to round-off).
 pub fn gauss_legendre(n: usize) -> Result<(Vec<f64>, Vec<f64>)> {
@@ -19,15 +31,7 @@ pub fn gauss_legendre(n: usize) -> Result<(Vec<f64>, Vec<f64>)> {
         let mut z = (std::f64::consts::PI * (i as f64 + 0.75) / (nf + 0.5)).cos();
         let mut dp = 1.0;
         for _ in 0..100 {
-            let (mut p0, mut p1) = (1.0, z);
-            for k in 2..=n {
-                let kf = k as f64;
-                let p2 = ((2.0 * kf - 1.0) * z * p1 - (kf - 1.0) * p0) / kf;
-                p0 = p1;
-                p1 = p2;
-            }
-            let pn = if n == 1 { z } else { p1 };
-            let pn1 = if n == 1 { 1.0 } else { p0 };
+            let (pn, pn1) = legendre(n, z);
             dp = nf * (z * pn - pn1) / (z * z - 1.0);
             let dz = pn / dp;
             z -= dz;
@@ -64,17 +68,7 @@ pub fn gauss_lobatto(n: usize) -> Result<(Vec<f64>, Vec<f64>)> {
     }
     let m = n - 1; // degree of the Legendre polynomial
     let mf = m as f64;
-    // P_m(z) and P_{m-1}(z)
-    let legendre = |z: f64| {
-        let (mut p0, mut p1) = (1.0, z);
-        for k in 2..=m {
-            let kf = k as f64;
-            let p2 = ((2.0 * kf - 1.0) * z * p1 - (kf - 1.0) * p0) / kf;
-            p0 = p1;
-            p1 = p2;
-        }
-        (p1, p0)
-    };
+    let legendre = |z: f64| legendre(m, z);
     let mut x = vec![0.0; n];
     let mut w = vec![0.0; n];
     for i in 0..n.div_ceil(2) {

@@ -64,6 +64,9 @@ pub struct Margins {
     pub worst_gap: f64,
     /// Time of `worst_gap` (s).
     pub worst_gap_time: f64,
+    /// The admissible gap (m): [`InvariantLimits::containment`] (the smallest over the
+    /// liquids of a vehicle).
+    pub gap_limit: f64,
     /// Largest energy growth ε (≤ 0 for a dissipative run).
     pub worst_energy_error: f64,
     /// Time of `worst_energy_error` (s).
@@ -98,6 +101,7 @@ impl Margins {
             (m.worst_energy_error, m.worst_energy_time) = (other.worst_energy_error, other.worst_energy_time);
         }
         m.dissipated = self.dissipated + other.dissipated;
+        m.gap_limit = self.gap_limit.min(other.gap_limit);
         m
     }
 }
@@ -107,6 +111,7 @@ impl Default for Margins {
         Self {
             worst_gap: 0.0,
             worst_gap_time: 0.0,
+            gap_limit: f64::INFINITY,
             worst_energy_error: f64::NEG_INFINITY,
             worst_energy_time: 0.0,
             min_volume_ratio: f64::INFINITY,
@@ -249,7 +254,7 @@ impl InvariantMonitor {
             input_work: 0.0,
             abs_work: 0.0,
             max_kinetic: 0.0,
-            margins: Margins::default(),
+            margins: Margins { gap_limit: limits.containment, ..Margins::default() },
         }
     }
 

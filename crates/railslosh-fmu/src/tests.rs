@@ -438,15 +438,26 @@ fn ancf_model_through_the_c_api() {
     // SAFETY: arrays of one.
     assert_eq!(unsafe { fmi3GetInt32(fmu.inst, &(VR_MODEL as u32), 1, &mut model, 1) }, Status::Ok);
     assert_eq!(model, 1);
-    let t = fmu.run(0.0, 0.03, 0.01);
+    // the weight, averaged over the first 0.2 s: the settling transient of the unloaded mesh
+    // on the penalty walls swings about it (at 0.05 s alone F_z was 1.3 m g with the
+    // unit-gradient elliptic wall of issue 16, 1.1 m g with the earlier gap function). This
+    // single-layer 1×2×1 mesh has no stable rest state: its field folds at 0.32 s, which the
+    // run-time element check stops (issue 16, docs/validation.md "Known gaps").
+    let mut fz = Vec::new();
+    let mut t = 0.0;
+    while t < 0.2 - 1e-9 {
+        t = fmu.run(t, t + 0.01, 0.01);
+        fz.push(fmu.outputs()[2]);
+    }
+    let mean = fz.iter().sum::<f64>() / fz.len() as f64;
+    assert!((mean / (-m * GRAVITY) - 1.0).abs() < 0.2, "mean F_z {mean} vs -m g {} ({fz:?})", -m * GRAVITY);
     let mut state: Fmi3FmuState = std::ptr::null_mut();
     // SAFETY: valid pointers.
     assert_eq!(unsafe { fmi3GetFMUState(fmu.inst, &mut state) }, Status::Ok);
-    fmu.run(t, 0.05, 0.01);
+    fmu.run(t, t + 0.02, 0.01);
     let first = fmu.outputs();
-    assert!((first[2] / (-m * GRAVITY) - 1.0).abs() < 0.2, "F_z {} vs -m g {}", first[2], -m * GRAVITY);
     assert_eq!(unsafe { fmi3SetFMUState(fmu.inst, state) }, Status::Ok);
-    fmu.run(t, 0.05, 0.01);
+    fmu.run(t, t + 0.02, 0.01);
     assert_eq!(fmu.outputs(), first);
     assert_eq!(unsafe { fmi3FreeFMUState(fmu.inst, &mut state) }, Status::Ok);
 }

@@ -635,6 +635,7 @@ pub(crate) fn margins_dict<'py>(py: Python<'py>, m: &rail_mbs::invariants::Margi
     let d = PyDict::new(py);
     d.set_item("worst_gap", m.worst_gap)?;
     d.set_item("worst_gap_time", m.worst_gap_time)?;
+    d.set_item("gap_limit", m.gap_limit)?;
     // not measured (vehicle runs keep no energy account): None
     d.set_item("worst_energy_error", m.worst_energy_error.is_finite().then_some(m.worst_energy_error))?;
     d.set_item("worst_energy_time", m.worst_energy_time)?;

@@ -9,6 +9,7 @@
 //! | `bulkhead-longitudinal` | under the same braking pulse, a tank car divided into three compartments by two bulkheads has a lower peak longitudinal load than the open tank |
 //! | `tank-frame-equivalence` | the same motion given as tank-frame pseudo-forces (seed 003 eq. 7.40) and as prescribed inertial motion gives the same loads |
 //! | `slosh-linear-potential-flow` | seed 003's rectangular tank under a 0.03 g lateral pulse (linear regime): the lateral load history vs the 50-mode linear potential-flow solution ([`super::linear_theory`]), RMS difference over 0.5–4 s ≤ 10 % of its peak; first-mode frequency from zero crossings vs 1.436 Hz |
+//! | `slosh-load-convergence` | the same tank under a 0.3 g lateral pulse (issue 16 §3): the peak lateral load after the pulse and f₁ from the zero crossings of the raw load change by ≤ 5 % between the two finest of three meshes and between two step sizes; on the finest mesh the raw zero-crossing frequency is within 3 % of the spectral peak (no chatter) |
 //!
 //! `quick` selects coarser meshes and shorter runs (as run in CI); the full forms are the
 //! long validation (`railslosh validate`).
@@ -231,7 +232,14 @@ fn slosh_rect_tank(quick: bool) -> Result<Vec<Record>> {
     let (mesh, fluid, geo) = rect_setup(counts)?;
     let mut motion = PrescribedMotion::at_rest([0.0; 3]);
     motion.translation[1] = PiecewiseAcceleration::pulse(0.3 * G, 0.0, 0.5, 0.01)?;
-    let (rec, _) = run(mesh, fluid, geo, 0.132, motion, SloshFrame::Inertial, t_end, 0.004)?;
+    // 4³ viscous and penalty points and 4×4 contact points per face: with the library's
+    // 3³ and 3×3 the quick mesh's position field folds between the force points (volume
+    // ratio 0.1 at a mass point at 2.32 s, caught by the run-time element check of issue
+    // 16); with these the smallest volume ratio stays 0.975 over the 3.5 s.
+    let mut law = WallContactLaw::default_for(fluid.density, G, 0.132);
+    law.points_per_edge = 4;
+    let quad = QuadratureOptions { viscous: 4, penalty: 4, ..QuadratureOptions::default() };
+    let (rec, _) = run_with(mesh, fluid, geo, law, quad, motion, SloshFrame::Inertial, t_end, 0.004)?;
     let fy: Vec<f64> = rec.force_tank.iter().map(|f| f[1]).collect();
     let f = dominant_frequency(&rec.t, &fy, 0.6, 0.3, 4.0);
     let fa = rect_tank_frequency(0.324, 0.132);
@@ -239,7 +247,10 @@ fn slosh_rect_tank(quick: bool) -> Result<Vec<Record>> {
         Record::abs(c, "analytic first-mode frequency (Hz), seed 003 MathCAD value 1.436", fa, 1.436, 0.001),
         Record::abs(
             c,
-            format!("first-mode frequency: spectral peak of the lateral load after the pulse (Hz), mesh {counts:?}"),
+            format!(
+                "first-mode frequency: spectral peak of the lateral load after the pulse (Hz), mesh {counts:?}, \
+                 4^3 force points, 4x4 contact points"
+            ),
             f,
             fa,
             0.05 * fa,
@@ -612,16 +623,27 @@ fn bulkhead_longitudinal(quick: bool) -> Result<Vec<Record>> {
 /// it passes 99 % of a 1.4 Hz sine with no phase shift), and the crossing times found by
 /// linear interpolation; f = (crossings − 1) / (2 (last − first)).
 fn zero_crossing_frequency(t: &[f64], x: &[f64], ta: f64, tb: f64) -> f64 {
+    let (gs, ys) = moving_average_1ms(t, x, ta, tb, 25);
+    crossing_frequency(&gs, &ys)
+}
+
+/// `x(t)` resampled every 1 ms over [ta, tb] and smoothed by a centred moving average of
+/// 2w + 1 samples: (times, values), w samples shorter at each end.
+fn moving_average_1ms(t: &[f64], x: &[f64], ta: f64, tb: f64, w: usize) -> (Vec<f64>, Vec<f64>) {
     let n = ((tb - ta) / 1e-3).round() as usize;
     let grid: Vec<f64> = (0..=n).map(|i| ta + (tb - ta) * i as f64 / n as f64).collect();
     let y: Vec<f64> = resample(t, &|i| [x[i], 0.0, 0.0], &grid).iter().map(|v| v[0]).collect();
-    let w = 25;
     let ys: Vec<f64> =
         (w..y.len().saturating_sub(w)).map(|i| y[i - w..=i + w].iter().sum::<f64>() / (2 * w + 1) as f64).collect();
-    let gs = &grid[w..grid.len().saturating_sub(w)];
-    let crossings: Vec<f64> = ys
+    (grid[w..grid.len().saturating_sub(w)].to_vec(), ys)
+}
+
+/// Mean frequency (Hz) from the zero crossings of the samples (t_i, y_i), crossing times by
+/// linear interpolation: f = (crossings − 1) / (2 (last − first)); NaN with fewer than 3.
+fn crossing_frequency(t: &[f64], y: &[f64]) -> f64 {
+    let crossings: Vec<f64> = y
         .windows(2)
-        .zip(gs.windows(2))
+        .zip(t.windows(2))
         .filter(|(v, _)| v[0] * v[1] < 0.0 || (v[0] == 0.0 && v[1] != 0.0))
         .map(|(v, g)| g[0] + (g[1] - g[0]) * v[0] / (v[0] - v[1]))
         .collect();
@@ -719,86 +741,141 @@ fn slosh_linear_potential_flow(quick: bool) -> Result<Vec<Record>> {
     ])
 }
 
-// DEVELOPMENT PROBE (to be replaced)
-fn env_f(name: &str, d: f64) -> f64 {
-    std::env::var(name).ok().and_then(|s| s.parse().ok()).unwrap_or(d)
+/// Lateral-load figures of one `slosh-load-convergence` run over the window after the pulse.
+struct PulseLoad {
+    /// Peak |F_y| of the recorded (raw) load (N).
+    peak: f64,
+    /// Peak |F_y| of its 51 ms moving average (N).
+    peak_smoothed: f64,
+    /// Frequency from the zero crossings of the raw recorded load, every step (Hz).
+    f_raw: f64,
+    /// Frequency from the zero crossings of the 51 ms moving average (Hz).
+    f_smoothed: f64,
+    /// Spectral peak of the lateral load in 0.3–4 Hz (Hz).
+    f_spectral: f64,
+    /// Accepted steps.
+    steps: usize,
 }
 
-fn zero_crossings_raw(t: &[f64], x: &[f64], ta: f64, tb: f64) -> (usize, f64) {
-    let i0 = t.iter().position(|&v| v >= ta).unwrap_or(t.len());
-    let mut c = Vec::new();
-    for i in i0..t.len().saturating_sub(1) {
-        if t[i + 1] > tb {
-            break;
-        }
-        let (a, b) = (x[i], x[i + 1]);
-        if a * b < 0.0 || (a == 0.0 && b != 0.0) {
-            c.push(t[i] + (t[i + 1] - t[i]) * a / (a - b));
-        }
-    }
-    if c.len() < 3 {
-        return (c.len(), f64::NAN);
-    }
-    (c.len(), (c.len() - 1) as f64 / (2.0 * (c[c.len() - 1] - c[0])))
-}
-
-fn slosh_load_convergence(_quick: bool) -> Result<Vec<Record>> {
-    let nx = env_f("LC_NX", 2.0) as usize;
-    let ny = env_f("LC_NY", 6.0) as usize;
-    let nz = env_f("LC_NZ", 2.0) as usize;
-    let h = env_f("LC_H", 0.004);
-    let pen = env_f("LC_PEN", 4.0) as usize;
-    let cpe = env_f("LC_CPE", 4.0) as usize;
-    let wall = env_f("LC_WALL", 100.0);
-    let dexp = env_f("LC_DEXP", 1.5);
-    let dmul = env_f("LC_DMUL", 1.0);
-    let t_end = env_f("LC_TEND", 4.0);
-    let (ta, tb) = (env_f("LC_TA", 0.7), t_end);
-    let counts = [nx, ny, nz];
+/// One run of `slosh-load-convergence`: 0.3 g lateral pulse on `counts`, steps ≤ `h`,
+/// figures of F_y over [t_a, t_b] (the run ends at t_b).
+fn pulse_load(counts: [usize; 3], h: f64, t_a: f64, t_b: f64) -> Result<PulseLoad> {
     let d = 0.132;
     let mut motion = PrescribedMotion::at_rest([0.0; 3]);
     motion.translation[1] = PiecewiseAcceleration::pulse(0.3 * G, 0.1, 0.6, 0.02)?;
     let (mesh, fluid, geo) = rect_setup(counts)?;
     let mut law = WallContactLaw::default_for(fluid.density, G, d);
-    law.stiffness *= wall;
-    law.damping *= wall.powf(dexp) * dmul;
-    law.points_per_edge = cpe;
-    let quad = QuadratureOptions { penalty: pen, ..QuadratureOptions::default() };
-    let tw = std::time::Instant::now();
-    let (rec, mass) = run_with(mesh, fluid, geo, law, quad, motion, SloshFrame::Inertial, t_end, h)?;
+    law.damping *= 30.0;
+    law.points_per_edge = 4;
+    let quad = QuadratureOptions { penalty: 4, ..QuadratureOptions::default() };
+    let (rec, _) = run_with(mesh, fluid, geo, law, quad, motion, SloshFrame::Inertial, t_b, h)?;
     let fy: Vec<f64> = rec.force_tank.iter().map(|f| f[1]).collect();
-    let peak = rec.t.iter().zip(&fy).filter(|(t, _)| **t >= ta).map(|(_, v)| v.abs()).fold(0.0, f64::max);
-    let (nc, f_raw) = zero_crossings_raw(&rec.t, &fy, ta, tb);
-    let f_sm = zero_crossing_frequency(&rec.t, &fy, ta, tb);
-    let f_sp = dominant_frequency(&rec.t, &fy, ta, 0.3, 4.0);
-    let f_hi = dominant_frequency(&rec.t, &fy, ta, 4.0, 120.0);
-    let steps = rec.t.len();
-    let hmin = rec.t.windows(2).map(|w| w[1] - w[0]).fold(f64::INFINITY, f64::min);
-    let maxit = rec.newton_iterations.iter().max().copied().unwrap_or(0);
-    // residual of the smoothed signal: RMS of raw - 51 ms moving average, relative to peak
-    let n = ((tb - ta) / 1e-3).round() as usize;
-    let grid: Vec<f64> = (0..=n).map(|i| ta + (tb - ta) * i as f64 / n as f64).collect();
-    let y: Vec<f64> = resample(&rec.t, &|i| [fy[i], 0.0, 0.0], &grid).iter().map(|v| v[0]).collect();
-    let w = 25;
-    let mut hf = 0.0;
-    let mut cnt = 0;
-    for i in w..y.len() - w {
-        let m = y[i - w..=i + w].iter().sum::<f64>() / (2 * w + 1) as f64;
-        hf += (y[i] - m).powi(2);
-        cnt += 1;
-    }
-    let hf = (hf / cnt as f64).sqrt();
-    let msg = format!(
-        "PROBE mesh {counts:?} h {h} pen {pen} cpe {cpe} wall {wall} dexp {dexp} dmul {dmul}: peak/(m.3g) {:.4} \
-         peakN {peak:.3} f_raw {f_raw:.4} (n {nc}) f_sm {f_sm:.4} f_sp {f_sp:.4} f_hi {f_hi:.2} hfRMS/peak {:.4} steps {steps} hmin {hmin:.2e} maxit {maxit} wall {:.1}s",
-        peak / (mass * 0.3 * G),
-        hf / peak,
-        tw.elapsed().as_secs_f64()
+    let i0 = rec.t.iter().position(|&t| t >= t_a).unwrap_or(rec.t.len());
+    let (ts, ys) = moving_average_1ms(&rec.t, &fy, t_a, t_b, 25);
+    Ok(PulseLoad {
+        peak: fy[i0..].iter().fold(0.0, |m: f64, v| m.max(v.abs())),
+        peak_smoothed: ys.iter().fold(0.0, |m: f64, v| m.max(v.abs())),
+        f_raw: crossing_frequency(&rec.t[i0..], &fy[i0..]),
+        f_smoothed: crossing_frequency(&ts, &ys),
+        f_spectral: dominant_frequency(&rec.t, &fy, t_a, 0.3, 4.0),
+        steps: rec.t.len() - 1,
+    })
+}
+
+/// `slosh-load-convergence` (issue 16 §3): seed 003's rectangular tank (0.416 m long, 0.324 m
+/// wide, 0.132 m of water; [`rect_setup`]) under a lateral (y) pulse of 0.3 g from 0.1 s to
+/// 0.6 s with 20 ms ramps. Lateral load on the tank (`force_tank` y) over the window after the
+/// pulse: its peak |F_y| and the first-mode frequency from the zero crossings of the RAW
+/// recorded load (every step, crossings by linear interpolation between steps; the 51 ms
+/// moving average's figures are reported in the text only). Checks: peak and f₁ change by
+/// ≤ 5 % between the two finest of three meshes and between two step sizes; on the finest
+/// mesh the raw zero-crossing frequency is within 3 % of the spectral peak
+/// ([`dominant_frequency`], 0.3–4 Hz): no chatter.
+///
+/// MEASUREMENTS: see the report; filled in below.
+fn slosh_load_convergence(quick: bool) -> Result<Vec<Record>> {
+    let c = "slosh-load-convergence";
+    let (meshes, h, h_fine, t_b): ([[usize; 3]; 3], f64, f64, f64) = if quick {
+        ([[2, 2, 2], [2, 3, 2], [2, 4, 2]], 0.004, 0.001, 2.5)
+    } else {
+        ([[2, 4, 2], [2, 6, 3], [2, 8, 4]], 0.004, 0.001, 4.0)
+    };
+    let t_a = 0.7;
+    let runs: Vec<PulseLoad> = meshes.iter().map(|&m| pulse_load(m, h, t_a, t_b)).collect::<Result<_>>()?;
+    let fine_step = pulse_load(meshes[1], h_fine, t_a, t_b)?;
+    let tag = format!(
+        "0.3 g lateral pulse 0.1-0.6 s (20 ms ramps), window {t_a}-{t_b} s, 4^3 penalty points, 4x4 contact \
+         points, contact damping x30"
     );
-    eprintln!("{msg}");
-    if std::env::var("LC_DUMP").is_ok() {
-        let s: String = rec.t.iter().zip(&fy).map(|(t, f)| format!("{t} {f}\n")).collect();
-        std::fs::write(std::env::var("LC_DUMP").unwrap(), s).ok();
-    }
-    Ok(vec![Record::at_most("slosh-load-convergence", msg, 0.0, 1.0)])
+    let fig = |r: &PulseLoad| {
+        format!(
+            "peak {:.2} N (51 ms average {:.2} N), f raw {:.4} Hz, smoothed {:.4} Hz, spectral {:.4} Hz, {} steps",
+            r.peak, r.peak_smoothed, r.f_raw, r.f_smoothed, r.f_spectral, r.steps
+        )
+    };
+    let per_mesh: Vec<String> =
+        meshes.iter().zip(&runs).map(|(m, r)| format!("{}x{}x{}: {}", m[0], m[1], m[2], fig(r))).collect();
+    let per_mesh = per_mesh.join("; ");
+    let (mid, fin) = (&runs[1], &runs[2]);
+    let [m1, m2] = [meshes[1], meshes[2]].map(|m| format!("{}x{}x{}", m[0], m[1], m[2]));
+    let rel = |a: f64, b: f64| (a - b).abs() / b.abs();
+    Ok(vec![
+        Record::abs(
+            c,
+            format!(
+                "peak |F_y| of the raw load after the pulse (N): mesh {m1} (measured) vs {m2} (reference), \
+                 tolerance 5 % of the reference (relative change {:.4}); {per_mesh}; h <= {h} s, {tag}",
+                rel(mid.peak, fin.peak)
+            ),
+            mid.peak,
+            fin.peak,
+            0.05 * fin.peak,
+        ),
+        Record::abs(
+            c,
+            format!(
+                "f1 from zero crossings of the raw load (Hz): mesh {m1} (measured) vs {m2} (reference), tolerance \
+                 5 % (relative change {:.4}); h <= {h} s, {tag}",
+                rel(mid.f_raw, fin.f_raw)
+            ),
+            mid.f_raw,
+            fin.f_raw,
+            0.05 * fin.f_raw,
+        ),
+        Record::abs(
+            c,
+            format!(
+                "peak |F_y| of the raw load after the pulse (N), mesh {m1}: h <= {h} s (measured) vs h <= {h_fine} s \
+                 (reference; {}), tolerance 5 % (relative change {:.4}), {tag}",
+                fig(&fine_step),
+                rel(mid.peak, fine_step.peak)
+            ),
+            mid.peak,
+            fine_step.peak,
+            0.05 * fine_step.peak,
+        ),
+        Record::abs(
+            c,
+            format!(
+                "f1 from zero crossings of the raw load (Hz), mesh {m1}: h <= {h} s (measured) vs h <= {h_fine} s \
+                 (reference), tolerance 5 % (relative change {:.4}), {tag}",
+                rel(mid.f_raw, fine_step.f_raw)
+            ),
+            mid.f_raw,
+            fine_step.f_raw,
+            0.05 * fine_step.f_raw,
+        ),
+        Record::abs(
+            c,
+            format!(
+                "no chatter, mesh {m2}: f1 from zero crossings of the RAW recorded load, every step (measured; \
+                 of the 51 ms moving average: {:.4} Hz) vs the spectral peak in 0.3-4 Hz (reference), tolerance 3 %, \
+                 h <= {h} s, {tag}",
+                fin.f_smoothed
+            ),
+            fin.f_raw,
+            fin.f_spectral,
+            0.03 * fin.f_spectral,
+        ),
+    ])
 }
