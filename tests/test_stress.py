@@ -246,7 +246,7 @@ slosh.run(mesh.box({BOX!r}, (2, 3, 2)), fluids.water(depth=0.132), tank, motion,
     proc = subprocess.Popen([sys.executable, "-c", script])
     try:
         for _ in range(600):
-            if path.exists() and path.stat().st_size > 400 + 30 * 21 * 8:
+            if path.exists() and path.stat().st_size > 400 + 30 * 26 * 8:  # 26 columns (issue 16 added 5)
                 break
             assert proc.poll() is None, "the run ended before it was killed"
             time.sleep(0.1)
