@@ -87,8 +87,9 @@ VARIABLES: dict[str, tuple[tuple[str, ...], str, str, str, dict[str, str]]] = {
 }
 
 _SCALARS = ("static_wheel_load", "dof", "fluid_mass", "elements")
-_CHOICE = ("fluid_model", "fluid_model_reason")
-"""The fluid model of a vehicle scene and why (:mod:`railslosh.fluid_model`), as global attributes."""
+_CHOICE = ("fluid_model", "fluid_model_reason", "load_filter")
+"""The fluid model of a vehicle scene and why (:mod:`railslosh.fluid_model`), and how its loads were
+recorded (``load_filter``), as global attributes."""
 
 
 def _scene_attrs(sc: Any) -> dict[str, Any]:

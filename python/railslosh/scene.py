@@ -21,7 +21,9 @@ A scene has these sections (every key optional unless marked; SI units, names en
 
 ``[train]``: ``cars`` (1-50), ``station`` (m, front tank centre at t = 0), ``speed`` (m/s) or
 ``speed_kmh``, ``drive`` (``true`` holds the front car to ``speed``, a number to that speed in m/s),
-``t_end``, ``step`` (maximum step), ``record_every`` (s), ``wheelset_lateral_offset`` (m),
+``t_end``, ``step`` (maximum step), ``record_every`` (s), ``load_filter`` (``"hat_mean"``, default: loads
+recorded as their anti-aliased hat-weighted mean over the steps, or ``"sample"``: point values; see
+:func:`railslosh.vehicle.run`), ``wheelset_lateral_offset`` (m),
 ``coupler_stiffness`` (N/m), ``coupler_damping`` (N s/m).
 
 ``[brake]``: ``times`` (s) and ``torques`` (N m per wheelset, against the motion), both required in
@@ -141,6 +143,8 @@ SLOSH_MODELS = ("auto", "ancf", "pendulum", "rigid")
 """Values of ``[fluid] slosh_model`` (see :mod:`railslosh.fluid_model`)."""
 _WHEEL_PROFILES = ("s1002", "aar1b")
 _BRAKE_SCOPES = ("all", "front")
+LOAD_FILTERS = ("hat_mean", "sample")
+"""Values of ``[train] load_filter``."""
 _MAX_SPEED = 70.0  # m/s (252 km/h)
 
 
@@ -332,6 +336,8 @@ class Scene:
     t_end: float = 1.0
     step: float = 1e-3
     record_every: float = 0.01
+    load_filter: str = "hat_mean"
+    """How load channels are recorded: ``"hat_mean"`` (anti-aliased) or ``"sample"``."""
     wheelset_lateral_offset: float = 0.0
     coupler_stiffness: float | None = None
     coupler_damping: float | None = None
@@ -373,6 +379,7 @@ class Scene:
             "t_end": self.t_end,
             "step": self.step,
             "record_every": self.record_every,
+            "load_filter": self.load_filter,
             "drive": self.drive,
             "brake": brake,
             "brake_scope": self.brake_scope,
@@ -448,6 +455,7 @@ def _to_dict(sc: Scene) -> dict[str, Any]:
         "t_end": sc.t_end,
         "step": sc.step,
         "record_every": sc.record_every,
+        "load_filter": sc.load_filter,
         "wheelset_lateral_offset": sc.wheelset_lateral_offset,
     }
     if sc.coupler_stiffness is not None:
@@ -524,6 +532,7 @@ _TRAIN_KEYS = (
     "t_end",
     "step",
     "record_every",
+    "load_filter",
     "wheelset_lateral_offset",
     "coupler_stiffness",
     "coupler_damping",
@@ -577,6 +586,7 @@ def scene_from_dict(data: Mapping[str, Any]) -> Scene:
     t_end = _number(tr.get("t_end", 1.0), "train.t_end", 0.0, 600.0, "s", open_lo=True)
     step = _number(tr.get("step", 1e-3), "train.step", 1e-6, 0.01, "s")
     record_every = _number(tr.get("record_every", 0.01), "train.record_every", step, 10.0, "s (>= train.step)")
+    load_filter = _choice(tr.get("load_filter", "hat_mean"), "train.load_filter", LOAD_FILTERS)
     offset = _number(tr.get("wheelset_lateral_offset", 0.0), "train.wheelset_lateral_offset", -0.0099, 0.0099, "m")
     k_c = tr.get("coupler_stiffness")
     coupler_k = None if k_c is None else _number(k_c, "train.coupler_stiffness", 1e3, 1e10, "N/m")
@@ -676,6 +686,7 @@ def scene_from_dict(data: Mapping[str, Any]) -> Scene:
         t_end=t_end,
         step=step,
         record_every=record_every,
+        load_filter=load_filter,
         wheelset_lateral_offset=offset,
         coupler_stiffness=coupler_k,
         coupler_damping=coupler_c,

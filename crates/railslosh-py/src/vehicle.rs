@@ -12,8 +12,8 @@ use rail_mbs::profile::aar1b_wheel_approx;
 use rail_mbs::track::{Track, TrackPoint};
 use rail_mbs::vehicle::studies::{Oil, brake_torque};
 use rail_mbs::vehicle::{
-    BrakeScope, EquivalentCargo, EquivalentModel, EquivalentTrainRecord, FluidCargo, FluidTrainRecord, Observer,
-    SampleSink, SloshAxis, TankCarParams, TrainRecord, TrainScenario,
+    BrakeScope, EquivalentCargo, EquivalentModel, EquivalentTrainRecord, FluidCargo, FluidTrainRecord, LoadFilter,
+    Observer, SampleSink, SloshAxis, TankCarParams, TrainRecord, TrainScenario,
     run_equivalent_train_streamed as rust_run_equivalent_train, run_fluid_train_streamed as rust_run_fluid_train,
     run_train_streamed as rust_run_train,
 };
@@ -179,7 +179,7 @@ fn brake_of(times: Option<Vec<f64>>, torques: Option<Vec<f64>>, scope: &str) -> 
 /// of arrays; on a failed run the dict has an `error` entry and the results so far.
 #[pyfunction]
 #[pyo3(signature = (
-    track, *, cars=1, station=50.0, speed=0.0, t_end=1.0, step=1e-3, record_every=0.01,
+    track, *, cars=1, station=50.0, speed=0.0, t_end=1.0, step=1e-3, record_every=0.01, load_filter="hat_mean",
     drive_speed=None, brake_times=None, brake_torques=None, brake_scope="all",
     lading_mass=0.0, lading_height=0.0, wheel_profile="s1002", wheelset_lateral_offset=0.0,
     coupler_stiffness=None, coupler_damping=None, car=None, progress=None, stream=None
@@ -194,6 +194,7 @@ pub fn run_train<'py>(
     t_end: f64,
     step: f64,
     record_every: f64,
+    load_filter: &str,
     drive_speed: Option<f64>,
     brake_times: Option<Vec<f64>>,
     brake_torques: Option<Vec<f64>>,
@@ -218,6 +219,7 @@ pub fn run_train<'py>(
     sc.cars = cars;
     sc.step = step;
     sc.record_every = record_every;
+    sc.load_filter = LoadFilter::parse(load_filter).map_err(crate::to_py)?;
     sc.drive = drive_speed.map(SpeedProfile::Constant);
     sc.brake = brake;
     sc.wheelset_lateral_offset = wheelset_lateral_offset;
@@ -321,7 +323,7 @@ pub fn design_brake_torque(mass: f64, v0: f64, v1: f64, duration: f64) -> PyResu
 /// the fluid load on each tank, volume errors and mesh snapshots.
 #[pyfunction]
 #[pyo3(signature = (
-    track, *, cars=1, station=300.0, speed=0.0, t_end=1.0, step=4e-3, record_every=0.02, snapshot_every=0.0,
+    track, *, cars=1, station=300.0, speed=0.0, t_end=1.0, step=4e-3, record_every=0.02, load_filter="hat_mean", snapshot_every=0.0,
     drive_speed=None, brake_times=None, brake_torques=None, brake_scope="all", brake_factors=None,
     oil="light", fluid=None, counts=(6, 4, 2), fill=0.5, bulkheads=None, wheel_profile="s1002", car=None,
     progress=None, stream=None
@@ -336,6 +338,7 @@ pub fn run_fluid_train<'py>(
     t_end: f64,
     step: f64,
     record_every: f64,
+    load_filter: &str,
     snapshot_every: f64,
     drive_speed: Option<f64>,
     brake_times: Option<Vec<f64>>,
@@ -368,6 +371,7 @@ pub fn run_fluid_train<'py>(
     sc.cars = cars;
     sc.step = step;
     sc.record_every = record_every;
+    sc.load_filter = LoadFilter::parse(load_filter).map_err(crate::to_py)?;
     sc.snapshot_every = snapshot_every;
     sc.drive = drive_speed.map(SpeedProfile::Constant);
     sc.brake = brake;
@@ -492,7 +496,7 @@ fn equivalent_record_dict<'py>(py: Python<'py>, r: &EquivalentTrainRecord) -> Py
 /// liquid centre of mass in the tank frame, the slosh displacements and the model.
 #[pyfunction]
 #[pyo3(signature = (
-    track, *, cars=1, station=50.0, speed=0.0, t_end=1.0, step=1e-3, record_every=0.01,
+    track, *, cars=1, station=50.0, speed=0.0, t_end=1.0, step=1e-3, record_every=0.01, load_filter="hat_mean",
     drive_speed=None, brake_times=None, brake_torques=None, brake_scope="all", brake_factors=None,
     oil="light", fluid=None, fill=0.5, bulkheads=None, slosh_axis="longitudinal",
     lading_mass=0.0, lading_height=0.0, wheel_profile="s1002", car=None, progress=None, stream=None
@@ -507,6 +511,7 @@ pub fn run_equivalent_train<'py>(
     t_end: f64,
     step: f64,
     record_every: f64,
+    load_filter: &str,
     drive_speed: Option<f64>,
     brake_times: Option<Vec<f64>>,
     brake_torques: Option<Vec<f64>>,
@@ -536,6 +541,7 @@ pub fn run_equivalent_train<'py>(
     sc.cars = cars;
     sc.step = step;
     sc.record_every = record_every;
+    sc.load_filter = LoadFilter::parse(load_filter).map_err(crate::to_py)?;
     sc.drive = drive_speed.map(SpeedProfile::Constant);
     sc.brake = brake;
     sc.brake_factors = brake_factors.unwrap_or_default();

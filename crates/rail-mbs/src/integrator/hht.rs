@@ -425,6 +425,14 @@ impl<S: MechanicalSystem> Hht<S> {
         self.jac_valid = false;
         &mut self.system
     }
+    /// The system, mutably, for an observation that leaves the model unchanged (its
+    /// scratch buffers may change, and any warm start it touches must be restored, as
+    /// [`crate::mbs::Multibody::wheelset_reports`] does): unlike
+    /// [`Hht::system_mut`] the cached forces and Jacobians stay valid, so recording
+    /// does not change the solution or its cost.
+    pub fn system_observed(&mut self) -> &mut S {
+        &mut self.system
+    }
     /// Consumes the integrator and returns the system.
     pub fn into_system(self) -> S {
         self.system

@@ -254,7 +254,8 @@ impl Multibody {
             .collect()
     }
 
-    /// Contact points of every wheelset at `(q, v)`.
+    /// Contact points of every wheelset at `(q, v)`; the contact searches' warm starts are
+    /// left as they were ([`crate::mbs::WheelsetContact::evaluate`]).
     pub fn wheelset_reports(&mut self, q: &[f64], v: &[f64]) -> Result<Vec<WheelsetReport>, SystemError> {
         let mut out = Vec::with_capacity(self.wheelsets.len());
         for k in 0..self.wheelsets.len() {

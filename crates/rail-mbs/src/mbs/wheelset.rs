@@ -37,11 +37,12 @@ fn pose(s: &BodyState) -> WheelPose {
 }
 
 impl WheelsetContact {
-    /// Contact points of both wheels at `state` (updates the warm start).
+    /// Contact points of both wheels at `state`, leaving the contact search's warm start
+    /// unchanged ([`WheelRailContact::observe`]).
     pub fn evaluate(&mut self, state: &BodyState) -> Result<WheelsetReport, ContactError> {
         let p = pose(state);
         let [l, r] = &mut self.wheels;
-        Ok(WheelsetReport { points: [l.evaluate(&p)?, r.evaluate(&p)?] })
+        Ok(WheelsetReport { points: [l.observe(&p)?, r.observe(&p)?] })
     }
 
     /// Total contact wrench on the wheelset about its centre of mass (no allocation once

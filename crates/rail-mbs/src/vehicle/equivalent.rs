@@ -78,7 +78,9 @@ use ancf_core::mesh::CylinderTankSpec;
 use ancf_core::{Fluid, Rheology};
 use nalgebra::{Matrix3, Vector3};
 
-use super::run::{Observer, SampleSink, TrainRecord, TrainScenario, build_train, record_sample, step_and_record};
+use super::run::{
+    Observer, RecordEvent, SampleSink, TrainRecord, TrainScenario, build_train, record_sample, step_and_record,
+};
 use super::tank_car::CarBodies;
 use crate::integrator::{Hht, IntegratorError};
 use crate::mbs::{BodyId, Bushing, Multibody, RigidBody};
@@ -733,13 +735,47 @@ pub fn run_equivalent_train_streamed(
         Err(error) => return Ok(Err(Box::new(EquivalentTrainFailure { error, record: finish(None, rec) }))),
     };
     let mut hints: Vec<f64> = cars.iter().flat_map(|c| [c.station; 4]).collect();
-    let result = step_and_record(&mut hht, sc, observe, |hht, _| {
+    let mut scratch = TrainRecord::default();
+    let result = step_and_record(&mut hht, sc, observe, |hht, event| {
         let (t, q, v) = (hht.t(), hht.q().to_vec(), hht.v().to_vec());
-        record_sample(hht.system_mut(), (t, &q, &v), &sc.track, &cars, &couplers, &mut hints, &mut rec.train)?;
-        record_equivalent(hht.system(), (&cars, &slosh, &model, tank_origin_height), &q, &mut rec);
-        match sink.as_mut() {
-            Some(sink) => sink(&rec.row(rec.train.t.len() - 1)),
-            None => Ok(()),
+        match event {
+            RecordEvent::Sample(_) => {
+                record_sample(
+                    hht.system_observed(),
+                    (t, &q, &v),
+                    &sc.track,
+                    &cars,
+                    &couplers,
+                    &mut hints,
+                    &mut rec.train,
+                )?;
+                record_equivalent(hht.system(), (&cars, &slosh, &model, tank_origin_height), &q, &mut rec);
+                Ok(())
+            }
+            RecordEvent::Loads(out) => {
+                scratch.clear_samples();
+                record_sample(
+                    hht.system_observed(),
+                    (t, &q, &v),
+                    &sc.track,
+                    &cars,
+                    &couplers,
+                    &mut hints,
+                    &mut scratch,
+                )?;
+                out.clear();
+                scratch.loads_into(0, out);
+                Ok(())
+            }
+            RecordEvent::Finish(k, loads) => {
+                if let Some(l) = loads {
+                    rec.train.set_loads(k, l);
+                }
+                match sink.as_mut() {
+                    Some(sink) => sink(&rec.row(k)),
+                    None => Ok(()),
+                }
+            }
         }
     });
     if let Err(error) = result {

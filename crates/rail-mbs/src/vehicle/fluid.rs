@@ -548,7 +548,9 @@ use ancf_core::mesh::{CylinderTankSpec, cylinder_tank, cylinder_tank_compartment
 use ancf_core::tank::{Bulkhead, TankGeometry, TankShape};
 use std::time::Instant;
 
-use super::run::{Observer, SampleSink, TrainRecord, TrainScenario, build_train, record_sample, step_and_record};
+use super::run::{
+    Observer, RecordEvent, SampleSink, TrainRecord, TrainScenario, build_train, record_sample, step_and_record,
+};
 use super::tank_car::CarBodies;
 use crate::integrator::{Hht, IntegratorError};
 
@@ -632,6 +634,29 @@ impl FluidTrainRecord {
             c.push(format!("volume_error[{k}]"));
         }
         c
+    }
+
+    /// The load channels of sample `i` ([`super::LoadFilter`]): those of
+    /// [`TrainRecord::loads_into`], then the fluid force on each tank (tank frame).
+    pub fn loads_into(&self, i: usize, out: &mut Vec<f64>) {
+        self.train.loads_into(i, out);
+        out.extend(self.fluid_force_tank[i].iter().flatten());
+    }
+
+    /// Replaces the load channels of sample `i` (layout of [`Self::loads_into`]).
+    pub fn set_loads(&mut self, i: usize, loads: &[f64]) {
+        let n = self.train.set_loads(i, loads);
+        for (x, &l) in self.fluid_force_tank[i].iter_mut().flatten().zip(&loads[n.min(loads.len())..]) {
+            *x = l;
+        }
+    }
+
+    fn clear_samples(&mut self) {
+        self.train.clear_samples();
+        self.oil_com_tank.clear();
+        self.oil_com_global.clear();
+        self.fluid_force_tank.clear();
+        self.volume_error.clear();
     }
 
     /// Sample `i` as one flat row in the order of [`Self::columns`].
@@ -770,22 +795,51 @@ pub fn run_fluid_train_streamed(
         Err(error) => return Ok(Err(Box::new(FluidTrainFailure { error, record: finish(None, rec) }))),
     };
     let mut hints: Vec<f64> = cars.iter().flat_map(|c| [c.station; 4]).collect();
-    let result = step_and_record(&mut hht, sc, observe, |hht, k| {
+    let mut scratch = FluidTrainRecord::default();
+    let result = step_and_record(&mut hht, sc, observe, |hht, event| {
         let (t, q, v) = (hht.t(), hht.q().to_vec(), hht.v().to_vec());
-        let sys = hht.system_mut();
-        record_sample(&mut sys.mb, (t, &q[..nr], &v[..nr]), &sc.track, &cars, &couplers, &mut hints, &mut rec.train)?;
-        record_fluid(hht.system(), &q, &v, &mut rec);
-        if sc.snapshot_every > 0.0 {
-            let every = (sc.snapshot_every / sc.record_every).round().max(1.0) as usize;
-            if k % every == 0 {
-                let sys = hht.system();
-                let e = (0..sys.fluids.len()).map(|f| sys.fluid_slice(f, &q).to_vec()).collect();
-                rec.snapshots.push((t, e));
+        match event {
+            RecordEvent::Sample(k) => {
+                let sys = hht.system_observed();
+                record_sample(
+                    &mut sys.mb,
+                    (t, &q[..nr], &v[..nr]),
+                    &sc.track,
+                    &cars,
+                    &couplers,
+                    &mut hints,
+                    &mut rec.train,
+                )?;
+                record_fluid(hht.system(), &q, &v, &mut rec);
+                if sc.snapshot_every > 0.0 {
+                    let every = (sc.snapshot_every / sc.record_every).round().max(1.0) as usize;
+                    if k % every == 0 {
+                        let sys = hht.system();
+                        let e = (0..sys.fluids.len()).map(|f| sys.fluid_slice(f, &q).to_vec()).collect();
+                        rec.snapshots.push((t, e));
+                    }
+                }
+                Ok(())
             }
-        }
-        match sink.as_mut() {
-            Some(sink) => sink(&rec.row(rec.train.t.len() - 1)),
-            None => Ok(()),
+            RecordEvent::Loads(out) => {
+                scratch.clear_samples();
+                let sys = hht.system_observed();
+                let state = (t, &q[..nr], &v[..nr]);
+                record_sample(&mut sys.mb, state, &sc.track, &cars, &couplers, &mut hints, &mut scratch.train)?;
+                record_fluid(hht.system(), &q, &v, &mut scratch);
+                out.clear();
+                scratch.loads_into(0, out);
+                Ok(())
+            }
+            RecordEvent::Finish(k, loads) => {
+                if let Some(l) = loads {
+                    rec.set_loads(k, l);
+                }
+                match sink.as_mut() {
+                    Some(sink) => sink(&rec.row(k)),
+                    None => Ok(()),
+                }
+            }
         }
     });
     if let Err(error) = result {

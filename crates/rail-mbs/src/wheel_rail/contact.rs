@@ -675,6 +675,18 @@ impl WheelRailContact {
         self.evaluate_cached(pose).map(<[ContactPoint]>::to_vec)
     }
 
+    /// [`Self::evaluate`] leaving the warm start of the search as it was: an observation
+    /// (recording loads between steps) then cannot change the next force evaluation's
+    /// search, so results do not depend on how often they are recorded.
+    pub fn observe(&mut self, pose: &WheelPose) -> Result<Vec<ContactPoint>, ContactError> {
+        let (previous, last_station) = (self.previous.clone(), self.last_station);
+        let result = self.evaluate(pose);
+        self.previous.clear();
+        self.previous.extend(previous);
+        self.last_station = last_station;
+        result
+    }
+
     /// [`Self::evaluate`] into a buffer of the contact, allocating nothing once the
     /// buffers have grown; the points stay valid until the next call.
     pub fn evaluate_cached(&mut self, pose: &WheelPose) -> Result<&[ContactPoint], ContactError> {
