@@ -43,7 +43,7 @@ fn main() {
         let res = run.run_to(t_end, 0.01);
         let wall = t0.elapsed().as_secs_f64();
         let s = run.stats();
-        let sim = run.hht.t();
+        let sim = run.stepper.t();
         if let Err(e) = res {
             println!("  ({nel} elements stopped early: {e})");
         }

@@ -82,18 +82,18 @@ fn main() {
     let mut run =
         SloshRun::new(sys, 0.0, HhtParams { abs_tol_acc: tol, rel_tol: 1e-4f64.min(tol), ..slosh_params() }).unwrap();
     run.run_to(t_settle, 0.02).unwrap();
-    let q = run.hht.q().to_vec();
+    let q = run.stepper.q().to_vec();
     {
         let rec = &run.record;
         let nrec = rec.t.len();
         for i in [nrec / 4, nrec / 2, 3 * nrec / 4, nrec - 1] {
             println!("t {:.2} KE {:.3e} com {:?}", rec.t[i], rec.kinetic_energy[i], rec.com_tank[i]);
         }
-        let vv = run.hht.v();
+        let vv = run.stepper.v();
         let vmax = vv.iter().enumerate().filter(|(i, _)| i % 12 < 3).map(|(_, x)| x.abs()).fold(0.0, f64::max);
         println!("max nodal speed {vmax:.3e}");
     }
-    let mut sys = run.hht.into_system();
+    let mut sys = run.stepper.into_system();
     let n = sys.n_coords();
     let v0 = vec![0.0; n];
     let mut res = vec![0.0; n];

@@ -70,7 +70,7 @@ fn negative_contact_damping_injects_energy_and_stops_with_the_energy_error() {
     // creates energy. (The law's validation refuses c < 0; this sets it past that, as a
     // defect in a contact model would.)
     let mut run = box_run(SloshFrame::Inertial, 0.3 * G, |_| {});
-    run.hht.system_mut().contact.law.damping *= -20.0;
+    run.stepper.system_mut().contact.law.damping *= -20.0;
     let err = run.run_to(2.0, 0.005).expect_err("energy creation must stop the run");
     assert_eq!(err.error.cause(), FailureCause::EnergyGrowth, "{}", err.error);
     let IntegratorError::System { t, source: SystemError::EnergyGrowth { relative, limit, .. } } = err.error.root()
@@ -92,7 +92,7 @@ fn leaky_walls_stop_with_the_containment_error_naming_the_site() {
     });
     // the per-step penetration guard of the contact points is disabled, so that only the
     // run-time invariant can stop the run
-    run.hht.system_mut().penetration_limit = f64::INFINITY;
+    run.stepper.system_mut().penetration_limit = f64::INFINITY;
     let limit = run.invariants.limits.containment;
     assert!(limit.is_finite() && limit > 0.0);
     let err = run.run_to(2.0, 0.005).expect_err("a liquid falling through its tank must stop the run");
@@ -116,7 +116,7 @@ fn a_liquid_at_rest_stays_at_rest_with_flat_energy() {
     let peak = |k: &[f64]| k.iter().fold(0.0f64, |m, x| m.max(*x));
     let (early, late) = (peak(&r.kinetic_energy[..half]), peak(&r.kinetic_energy[half..]));
     let m = run.margins();
-    let mgh = run.hht.system().body.total_mass() * G * L[2];
+    let mgh = run.stepper.system().body.total_mass() * G * L[2];
     // the settling of the penalty pressure is the only motion, and it decays
     assert!(early < 1e-3 * mgh, "kinetic energy while settling {early} J (m g H = {mgh} J)");
     assert!(late < 0.5 * early, "kinetic energy at rest does not decay: {early} J, then {late} J");
@@ -154,8 +154,8 @@ fn swri_rest_lambda_min(np: usize, ppe: usize, walls: f64) -> f64 {
             .unwrap();
     let mut run = SloshRun::new(sys, 0.0, slosh_params()).unwrap();
     run.run_to(3.0, 0.02).unwrap();
-    let q = run.hht.q().to_vec();
-    let mut sys = run.hht.into_system();
+    let q = run.stepper.q().to_vec();
+    let mut sys = run.stepper.into_system();
     let modes = linear_modes(&mut sys, 3.0, &q).unwrap();
     modes.omega_sq[0] * depth / G
 }

@@ -129,6 +129,7 @@
 //! faer's low-level LU API.
 
 mod error;
+mod explicit;
 mod hht;
 mod iterative;
 mod journal;
@@ -138,6 +139,7 @@ mod stats;
 mod system;
 
 pub use error::{FailureCause, IntegratorError, KktIndex, Quantity, SystemError};
+pub use explicit::{BlockMass, Explicit, ExplicitParams, StableStep};
 pub use hht::{Checkpoint, Hht, StateRef, StepInfo};
 pub use iterative::{IterativeParams, LinearSolverKind};
 pub use journal::{CheckpointFile, Journal, read_journal};

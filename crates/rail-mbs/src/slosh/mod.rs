@@ -17,7 +17,9 @@ pub use system::{SloshFrame, SloshSystem};
 
 use nalgebra::Vector3;
 
-use crate::integrator::{Checkpoint, CheckpointFile, Hht, HhtParams, IntegratorError, Journal, Stats};
+use crate::integrator::{
+    Checkpoint, CheckpointFile, Explicit, ExplicitParams, Hht, HhtParams, IntegratorError, Journal, Stats,
+};
 use crate::invariants::{EnergySample, InvariantMonitor, Margins};
 use crate::vehicle::{Observer, Progress};
 
@@ -43,7 +45,8 @@ pub struct SloshRecord {
     pub kinetic_energy: Vec<f64>,
     /// Gravitational potential energy (J).
     pub potential_energy: Vec<f64>,
-    /// Newton iterations of the step.
+    /// Newton iterations of the step (implicit), or explicit sub-steps since the last
+    /// sample.
     pub newton_iterations: Vec<usize>,
     /// Largest wall penetration (m).
     pub max_penetration: Vec<f64>,
@@ -113,10 +116,105 @@ impl SloshRecord {
     }
 }
 
-/// A slosh run: the integrator, its system and the record.
+/// The time stepper of a slosh run (issue 17): implicit HHT-α (Newton on the sparse
+/// system), or explicit central differences with the constant mass factored once
+/// ([`crate::integrator::Explicit`]), sub-stepping within each recorded step at the stable
+/// step.
+pub enum SloshStepper {
+    /// Implicit HHT-α.
+    Implicit(Hht<SloshSystem>),
+    /// Explicit central differences.
+    Explicit(Box<Explicit<SloshSystem>>),
+}
+
+impl std::fmt::Debug for SloshStepper {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "SloshStepper::{}(t = {})", self.name(), self.t())
+    }
+}
+
+impl SloshStepper {
+    /// Current time, s.
+    pub fn t(&self) -> f64 {
+        match self {
+            Self::Implicit(h) => h.t(),
+            Self::Explicit(e) => e.t(),
+        }
+    }
+    /// Current coordinates.
+    pub fn q(&self) -> &[f64] {
+        match self {
+            Self::Implicit(h) => h.q(),
+            Self::Explicit(e) => e.q(),
+        }
+    }
+    /// Current velocities.
+    pub fn v(&self) -> &[f64] {
+        match self {
+            Self::Implicit(h) => h.v(),
+            Self::Explicit(e) => e.v(),
+        }
+    }
+    /// The system.
+    pub fn system(&self) -> &SloshSystem {
+        match self {
+            Self::Implicit(h) => h.system(),
+            Self::Explicit(e) => e.system(),
+        }
+    }
+    /// The system, mutably (the implicit stepper then re-evaluates its cached forces).
+    pub fn system_mut(&mut self) -> &mut SloshSystem {
+        match self {
+            Self::Implicit(h) => h.system_mut(),
+            Self::Explicit(e) => e.system_mut(),
+        }
+    }
+    /// Counters (for the explicit stepper: steps, force evaluations, mass solves).
+    pub fn stats(&self) -> &Stats {
+        match self {
+            Self::Implicit(h) => h.stats(),
+            Self::Explicit(e) => e.stats(),
+        }
+    }
+    /// The implicit integrator, if this is one.
+    pub fn hht(&self) -> Option<&Hht<SloshSystem>> {
+        match self {
+            Self::Implicit(h) => Some(h),
+            Self::Explicit(_) => None,
+        }
+    }
+    /// Name: `"implicit"` or `"explicit"`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Implicit(_) => "implicit",
+            Self::Explicit(_) => "explicit",
+        }
+    }
+    /// Consumes the stepper and returns the system.
+    pub fn into_system(self) -> SloshSystem {
+        match self {
+            Self::Implicit(h) => h.into_system(),
+            Self::Explicit(e) => e.into_system(),
+        }
+    }
+    /// Advances by one recorded step to `t + h`: one HHT step (it may take a shorter
+    /// one), or explicit sub-steps landing on `t + h`. Returns the Newton iterations
+    /// (implicit) or the sub-steps (explicit).
+    fn advance(&mut self, h: f64) -> Result<usize, IntegratorError> {
+        match self {
+            Self::Implicit(hht) => hht.step(h).map(|i| i.iterations),
+            Self::Explicit(e) => {
+                let t = e.t() + h;
+                e.advance_to(t)
+            }
+        }
+    }
+}
+
+/// A slosh run: the stepper, its system and the record.
 pub struct SloshRun {
-    /// The integrator (owns the system).
-    pub hht: Hht<SloshSystem>,
+    /// The time stepper (owns the system).
+    pub stepper: SloshStepper,
     /// Outputs so far.
     pub record: SloshRecord,
     /// Periodic checkpoints (`None`: none written): after every accepted step the file
@@ -146,9 +244,22 @@ impl SloshRun {
     /// Start at t0 from the system's initial state (fluid moving rigidly with the tank).
     pub fn new(system: SloshSystem, t0: f64, params: HhtParams) -> Result<Self, IntegratorError> {
         let (q, v) = system.initial_state(t0);
-        let invariants = system.invariant_monitor();
         let hht = Hht::new(system, t0, q, v, params)?;
-        let mut run = Self { hht, record: SloshRecord::default(), checkpoints: None, invariants };
+        Self::with_stepper(SloshStepper::Implicit(hht))
+    }
+
+    /// [`SloshRun::new`] with the explicit stepper (issue 17): the fluid's constant mass
+    /// is factored once and each recorded step is sub-stepped at the stable step.
+    pub fn new_explicit(system: SloshSystem, t0: f64, params: ExplicitParams) -> Result<Self, IntegratorError> {
+        let (q, v) = system.initial_state(t0);
+        let m_s = system.body.scalar_mass().clone();
+        let e = Explicit::new(system, &m_s, t0, q, v, params)?;
+        Self::with_stepper(SloshStepper::Explicit(Box::new(e)))
+    }
+
+    fn with_stepper(stepper: SloshStepper) -> Result<Self, IntegratorError> {
+        let invariants = stepper.system().invariant_monitor();
+        let mut run = Self { stepper, record: SloshRecord::default(), checkpoints: None, invariants };
         run.record_state(0)?;
         Ok(run)
     }
@@ -156,20 +267,22 @@ impl SloshRun {
     /// Resume from a checkpoint of an earlier run of the same system (same mesh, fluid,
     /// tank, motion and parameters): the record starts with the checkpoint's state, and
     /// the continuation is bitwise identical to the uninterrupted run's (its first
-    /// sample reports 0 Newton iterations).
+    /// sample reports 0 Newton iterations). Implicit runs only.
     pub fn resume(system: SloshSystem, checkpoint: &Checkpoint, params: HhtParams) -> Result<Self, IntegratorError> {
-        let invariants = system.invariant_monitor();
         let hht = Hht::restore(system, checkpoint, params)?;
-        let mut run = Self { hht, record: SloshRecord::default(), checkpoints: None, invariants };
-        run.record_state(0)?;
-        Ok(run)
+        Self::with_stepper(SloshStepper::Implicit(hht))
     }
 
     /// Write a checkpoint if one is due.
     fn checkpoint_if_due(&mut self) -> Result<(), IntegratorError> {
-        match self.checkpoints.as_mut() {
-            Some(c) => c.maybe_write(&self.hht).map(|_| ()),
-            None => Ok(()),
+        match (self.checkpoints.as_mut(), &self.stepper) {
+            (Some(c), SloshStepper::Implicit(hht)) => c.maybe_write(hht).map(|_| ()),
+            (Some(_), SloshStepper::Explicit(_)) => Err(IntegratorError::InvalidParameter {
+                field: "checkpoint_every",
+                value: 0.0,
+                allowed: "checkpoints with the implicit stepper only",
+            }),
+            (None, _) => Ok(()),
         }
     }
 
@@ -194,18 +307,26 @@ impl SloshRun {
         mut journal: Option<&mut Journal>,
     ) -> Result<(), Box<SloshFailure>> {
         let fail = |run: &Self, error| Box::new(SloshFailure { error, record: run.record.clone() });
-        while t_end - self.hht.t() > 1e-12 * (1.0 + t_end.abs()) {
-            let h_step = h.min(t_end - self.hht.t());
-            match self.hht.step(h_step) {
-                Ok(info) => self.record_state(info.iterations).map_err(|e| fail(self, e))?,
+        while t_end - self.stepper.t() > 1e-12 * (1.0 + t_end.abs()) {
+            let h_step = h.min(t_end - self.stepper.t());
+            match self.stepper.advance(h_step) {
+                Ok(iterations) => self.record_state(iterations).map_err(|e| fail(self, e))?,
                 Err(error) => return Err(fail(self, error)),
             }
             if let Some(j) = journal.as_deref_mut() {
                 j.append(&self.record.row(self.record.t.len() - 1)).map_err(|e| fail(self, e))?;
             }
             self.checkpoint_if_due().map_err(|e| fail(self, e))?;
-            if !observe(&Progress::of(&self.hht, t_end)) {
-                return Err(fail(self, crate::vehicle::stopped_by_observer(self.hht.t())));
+            let s = self.stepper.stats();
+            let progress = Progress {
+                t: self.stepper.t(),
+                t_end,
+                steps: s.steps,
+                newton_iterations: s.newton_iterations,
+                rejected_steps: s.rejected_steps,
+            };
+            if !observe(&progress) {
+                return Err(fail(self, crate::vehicle::stopped_by_observer(self.stepper.t())));
             }
         }
         Ok(())
@@ -233,7 +354,7 @@ impl SloshRun {
 
     /// Integrator statistics.
     pub fn stats(&self) -> &Stats {
-        self.hht.stats()
+        self.stepper.stats()
     }
 
     /// Worst invariant margins so far (containment gap, energy growth, volume ratio).
@@ -245,8 +366,8 @@ impl SloshRun {
     /// ([`crate::invariants`]): a violation is returned as a located error at this time,
     /// with the violating sample recorded.
     fn record_state(&mut self, iterations: usize) -> Result<(), IntegratorError> {
-        let sys = self.hht.system();
-        let (t, q, v) = (self.hht.t(), self.hht.q(), self.hht.v());
+        let sys = self.stepper.system();
+        let (t, q, v) = (self.stepper.t(), self.stepper.q(), self.stepper.v());
         let load = sys.contact_load(t, q, v);
         let state = sys.motion.state(t);
         let a = state.kinematics.rotation;

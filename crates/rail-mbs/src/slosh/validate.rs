@@ -402,8 +402,8 @@ fn settled(
     let fail = |e: String| AncfError::NonFinite { what: e, element: 0 };
     let mut run = SloshRun::new(sys, 0.0, slosh_params()).map_err(|e| fail(e.to_string()))?;
     run.run_to(t_settle, 0.02).map_err(|e| fail(e.to_string()))?;
-    let q = run.hht.q().to_vec();
-    Ok((run.hht.into_system(), q))
+    let q = run.stepper.q().to_vec();
+    Ok((run.stepper.into_system(), q))
 }
 
 fn slosh_cylinder_half(quick: bool) -> Result<Vec<Record>> {
