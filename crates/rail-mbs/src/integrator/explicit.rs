@@ -289,7 +289,7 @@ impl<S: MechanicalSystem> Explicit<S> {
         let norm = |x: &[f64]| x.iter().map(|a| a * a).sum::<f64>().sqrt();
         for _ in 0..iterations {
             let nx = norm(&x);
-            if !(nx > 0.0) {
+            if nx.is_nan() || nx <= 0.0 {
                 break;
             }
             x.iter_mut().for_each(|a| *a /= nx);

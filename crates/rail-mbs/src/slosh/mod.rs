@@ -120,6 +120,7 @@ impl SloshRecord {
 /// system), or explicit central differences with the constant mass factored once
 /// ([`crate::integrator::Explicit`]), sub-stepping within each recorded step at the stable
 /// step.
+#[allow(clippy::large_enum_variant)] // one per run, never moved in a loop
 pub enum SloshStepper {
     /// Implicit HHT-α.
     Implicit(Hht<SloshSystem>),
