@@ -64,3 +64,28 @@ def test_a_failing_run_says_where_and_keeps_what_it_computed():
     assert len(res["t"]) > 10 and res["error"]
     assert np.all(np.isfinite(res["force_tank"]))
     assert isinstance(info.value, rs.RailsloshError)
+
+
+def test_the_explicit_stepper_runs_the_same_physics_and_says_which_stepper_ran():
+    """Issue 17: ``stepper="explicit"`` (factor-once mass, stable sub-steps) reproduces the
+    implicit run's hydrostatics and sloshing; ``"auto"`` picks one and says why."""
+    mesh, tank, water = small_tank()
+    motion = rs.slosh.Motion().pulse("y", 2.0, 0.05, 0.35, ramp=0.05)
+    kw = dict(t_end=0.6, h=0.01, viscous_points=4, penalty_points=4)
+    imp = rs.slosh.run(mesh, water, tank, motion, **kw)
+    exp = rs.slosh.run(mesh, water, tank, motion, **kw, stepper="explicit")
+    assert imp["stepper"] == "implicit" and exp["stepper"] == "explicit"
+    assert exp["stepper_reason"] == "requested: explicit"
+    # many explicit sub-steps per recorded step, each one force evaluation, no Newton
+    assert exp["stats"]["steps"] > 5 * len(exp["t"]) and exp["stats"]["newton_iterations"] == 0
+    # the implicit stepper may shorten its steps: compare on the explicit record's times
+    y_imp = np.interp(exp["t"], imp["t"], imp["com_tank"][:, 1])
+    y_range = np.ptp(y_imp)
+    assert y_range > 1e-3
+    assert np.abs(exp["com_tank"][:, 1] - y_imp).max() < 0.05 * y_range
+    assert exp["margins"]["worst_energy_error"] < 1e-3
+    auto = rs.slosh.run(mesh, water, tank, motion, **{**kw, "t_end": 0.05}, stepper="auto")
+    assert auto["stepper"] in ("implicit", "explicit")
+    assert auto["stepper_reason"].startswith("auto: stable explicit step") and auto["stepper"] in auto["stepper_reason"]
+    with pytest.raises(ValueError, match="stepper"):
+        rs.slosh.run(mesh, water, tank, t_end=0.05, stepper="rk4")

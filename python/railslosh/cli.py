@@ -237,7 +237,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
         "margins": res.get("margins"),
     }
     # the model the run used (run_scene records it, also on a failed run)
-    summary |= {k: res[k] for k in ("fluid_model", "fluid_model_reason") if k in res}
+    summary |= {k: res[k] for k in ("fluid_model", "fluid_model_reason", "stepper", "stepper_reason") if k in res}
     (out / "run.json").write_text(json.dumps(summary, indent=1, default=str), encoding="utf-8")
     print(
         f"  {st.get('steps', 0)} steps, {st.get('newton_iterations', 0)} Newton iterations, "

@@ -143,6 +143,8 @@ SLOSH_MODELS = ("auto", "ancf", "pendulum", "rigid")
 """Values of ``[fluid] slosh_model`` (see :mod:`railslosh.fluid_model`)."""
 _WHEEL_PROFILES = ("s1002", "aar1b")
 _BRAKE_SCOPES = ("all", "front")
+STEPPERS = ("implicit", "explicit", "auto")
+"""Values of ``[solver] stepper`` of slosh scenes."""
 LOAD_FILTERS = ("hat_mean", "sample")
 """Values of ``[train] load_filter``."""
 _MAX_SPEED = 70.0  # m/s (252 km/h)
@@ -854,7 +856,8 @@ class SloshScene:
     under violent maneuvers need more (the SwRI scenes use 4, 4, 5: docs/validation.md, "Run-time
     invariants"). ``[solver]``:
     ``t_end`` (s), ``step`` (s), ``frame`` (``"inertial"`` or ``"tank"``), ``contact_stiffness_factor``
-    (wall stiffness as a multiple of the default penalty law, 0.1 to 1000). ``[outputs]``: ``netcdf``, ``plots``.
+    (wall stiffness as a multiple of the default penalty law, 0.1 to 1000), ``stepper``
+    (``"implicit"``, default; ``"explicit"``; ``"auto"``: see :func:`railslosh.slosh.run`). ``[outputs]``: ``netcdf``, ``plots``.
     ``[maneuver]``: ``type`` =
 
     * ``"lane_change"``: lateral (y) displacement ``offset`` (m, default 3.66 = 12 ft) over ``length``
@@ -888,6 +891,8 @@ class SloshScene:
     """Gauss points per direction of the volumetric penalty (2 to 6)."""
     contact_points_per_edge: int = 3
     """Wall-contact Gauss points per boundary-face edge (2 to 6)."""
+    stepper: str = "implicit"
+    """``"implicit"``, ``"explicit"`` or ``"auto"`` (:func:`railslosh.slosh.run`)."""
     name: str = ""
     description: str = ""
     outputs: Outputs = field(default_factory=lambda: Outputs(vtu=False))
@@ -963,6 +968,7 @@ class SloshScene:
             "viscous_points": self.viscous_points,
             "penalty_points": self.penalty_points,
             "contact_points_per_edge": self.contact_points_per_edge,
+            "stepper": self.stepper,
         }
         if self.contact_stiffness_factor != 1.0:
             kw["contact_stiffness_factor"] = self.contact_stiffness_factor
@@ -1182,7 +1188,8 @@ def slosh_scene_from_dict(data: Mapping[str, Any]) -> SloshScene:
             )
     name, description = _meta(data)
     sv = _table(data.get("solver", {}), "solver")
-    _check_keys(sv, "solver", ("t_end", "step", "frame", "contact_stiffness_factor"))
+    _check_keys(sv, "solver", ("t_end", "step", "frame", "contact_stiffness_factor", "stepper"))
+    stepper = _choice(sv.get("stepper", "implicit"), "solver.stepper", STEPPERS)
     wall = _number(sv.get("contact_stiffness_factor", 1.0), "solver.contact_stiffness_factor", 0.1, 1000.0, "")
     t_end = _number(sv.get("t_end", 2.0), "solver.t_end", 0.0, 600.0, "s", open_lo=True)
     step = _number(sv.get("step", 0.01), "solver.step", 1e-5, min(0.05, t_end), "s (<= t_end)")
@@ -1219,6 +1226,7 @@ def slosh_scene_from_dict(data: Mapping[str, Any]) -> SloshScene:
         step=step,
         frame=frame,
         contact_stiffness_factor=wall,
+        stepper=stepper,
         name=name,
         description=description,
         outputs=outputs,

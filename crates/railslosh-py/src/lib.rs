@@ -443,7 +443,7 @@ impl PyFluidBody {
                     t_end, h, frame="inertial", gravity=[0.0, 0.0, -9.81], viscous_points=3, penalty_points=3,
                     progress=None, volume_tolerance=0.01, penetration_limit=0.5, contact_stiffness_factor=1.0,
                     stream=None, checkpoint=None, checkpoint_every=100, resume_from=None,
-                    contact_points_per_edge=3, contact_point_rule="gauss"))]
+                    contact_points_per_edge=3, contact_point_rule="gauss", stepper="implicit"))]
 #[allow(clippy::too_many_arguments)]
 fn run_slosh<'py>(
     py: Python<'py>,
@@ -471,10 +471,19 @@ fn run_slosh<'py>(
     resume_from: Option<std::path::PathBuf>,
     contact_points_per_edge: usize,
     contact_point_rule: &str,
+    stepper: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     use ancf_core::contact::{ContactPointRule, WallContact, WallContactLaw};
     use ancf_core::tank::{Bulkhead, TankGeometry, TankShape};
-    use rail_mbs::slosh::{PiecewiseAcceleration, PrescribedMotion, SloshFrame, SloshRun, SloshSystem};
+    use rail_mbs::slosh::{PiecewiseAcceleration, PrescribedMotion, SloshFrame, SloshRun, SloshSystem, StepperChoice};
+    let choice = StepperChoice::parse(stepper).map_err(crate::to_py)?;
+    if choice != StepperChoice::Implicit && (resume_from.is_some() || checkpoint.is_some()) {
+        return Err(crate::to_py(ancf_core::error::invalid(
+            "stepper",
+            stepper,
+            "\"implicit\" with checkpoint or resume_from (explicit runs write no checkpoints yet)",
+        )));
+    }
     let bad =
         |f: &str, v: String, a: &str| PyValueError::new_err(format!("invalid parameter `{f}` = {v}: allowed {a}"));
     let shape = match (tank_shape, tank_dims.as_slice()) {
@@ -548,6 +557,8 @@ fn run_slosh<'py>(
         sys.volume_tolerance = volume_tolerance;
         sys.penetration_limit *= penetration_limit / rail_mbs::slosh::system::PENETRATION_LIMIT_FACTOR;
         let params = rail_mbs::slosh::validate::slosh_params();
+        let explicit = rail_mbs::integrator::ExplicitParams::default();
+        let mut reason = String::from("requested: implicit");
         let mut run = match &resume_from {
             // Issue 8: continue a run from its last checkpoint, bitwise as if never stopped.
             Some(path) => {
@@ -563,7 +574,10 @@ fn run_slosh<'py>(
                 })?
             }
             None => {
-                SloshRun::new(sys, 0.0, params).map_err(|e| AncfError::NonFinite { what: e.to_string(), element: 0 })?
+                let (run, why) = SloshRun::with_choice(sys, 0.0, choice, h, params, explicit)
+                    .map_err(|e| AncfError::NonFinite { what: e.to_string(), element: 0 })?;
+                reason = why;
+                run
             }
         };
         if let Some(path) = &checkpoint {
@@ -588,10 +602,11 @@ fn run_slosh<'py>(
         let err = result.err().map(|e| e.error.to_string());
         let s = *run.stats();
         let margins = run.margins();
-        Ok((run.record, err, s, margins))
+        let used = run.stepper.name();
+        Ok((run.record, err, s, margins, used, reason))
     })?;
     observer.finish()?;
-    let (rec, err, stats, margins) = result;
+    let (rec, err, stats, margins, used, reason) = result;
     let d = PyDict::new(py);
     let v3 = |x: &Vec<[f64; 3]>| -> PyResult<Bound<'py, PyAny>> {
         let n = x.len();
@@ -614,6 +629,8 @@ fn run_slosh<'py>(
     d.set_item("min_volume_ratio", PyArray1::from_vec(py, rec.min_volume_ratio))?;
     d.set_item("containment_gap", PyArray1::from_vec(py, rec.containment_gap))?;
     d.set_item("margins", margins_dict(py, &margins)?)?;
+    d.set_item("stepper", used)?;
+    d.set_item("stepper_reason", reason)?;
     d.set_item("error", err)?;
     let st = PyDict::new(py);
     st.set_item("steps", stats.steps)?;

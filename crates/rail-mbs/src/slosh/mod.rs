@@ -212,6 +212,36 @@ impl SloshStepper {
     }
 }
 
+/// Which stepper a slosh run uses (scene `[solver] stepper`, Python `stepper=`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum StepperChoice {
+    /// Implicit HHT-α (default).
+    #[default]
+    Implicit,
+    /// Explicit central differences, constant mass factored once.
+    Explicit,
+    /// The cheaper of the two, from the stable step at the start (see
+    /// [`IMPLICIT_STEP_COST`]).
+    Auto,
+}
+
+impl StepperChoice {
+    /// Parses `"implicit"`, `"explicit"` or `"auto"`.
+    pub fn parse(name: &str) -> Result<Self, ancf_core::error::AncfError> {
+        match name {
+            "implicit" => Ok(Self::Implicit),
+            "explicit" => Ok(Self::Explicit),
+            "auto" => Ok(Self::Auto),
+            other => Err(ancf_core::error::invalid("stepper", other, "\"implicit\", \"explicit\" or \"auto\"")),
+        }
+    }
+}
+
+/// Cost of one implicit slosh step in force evaluations (what one explicit step costs),
+/// measured with `cargo run --release -p rail-mbs --example explicit_bench` (docs/benchmarks.md,
+/// "Explicit against implicit"): Newton iterations × (force + Jacobian share + sparse solve).
+pub const IMPLICIT_STEP_COST: f64 = 25.0;
+
 /// A slosh run: the stepper, its system and the record.
 pub struct SloshRun {
     /// The time stepper (owns the system).
@@ -256,6 +286,38 @@ impl SloshRun {
         let m_s = system.body.scalar_mass().clone();
         let e = Explicit::new(system, &m_s, t0, q, v, params)?;
         Self::with_stepper(SloshStepper::Explicit(Box::new(e)))
+    }
+
+    /// A run with the stepper `choice` for recorded steps of `h`; returns it with the
+    /// reason of the choice (for `auto`: the estimated cost of both per recorded step).
+    pub fn with_choice(
+        system: SloshSystem,
+        t0: f64,
+        choice: StepperChoice,
+        h: f64,
+        implicit: HhtParams,
+        explicit: ExplicitParams,
+    ) -> Result<(Self, String), IntegratorError> {
+        match choice {
+            StepperChoice::Implicit => Ok((Self::new(system, t0, implicit)?, "requested: implicit".into())),
+            StepperChoice::Explicit => Ok((Self::new_explicit(system, t0, explicit)?, "requested: explicit".into())),
+            StepperChoice::Auto => {
+                let (q, v) = system.initial_state(t0);
+                let m_s = system.body.scalar_mass().clone();
+                let mut e = Explicit::new(system, &m_s, t0, q, v, explicit)?;
+                let h_e = e.stable_step()?;
+                let explicit_cost = (h / h_e).ceil();
+                let reason = format!(
+                    "auto: stable explicit step {h_e:.3e} s, {explicit_cost:.0} force evaluations per {h} s step \
+                     against about {IMPLICIT_STEP_COST:.0} for an implicit step"
+                );
+                if explicit_cost <= IMPLICIT_STEP_COST {
+                    Ok((Self::with_stepper(SloshStepper::Explicit(Box::new(e)))?, format!("{reason}: explicit")))
+                } else {
+                    Ok((Self::new(e.into_system(), t0, implicit)?, format!("{reason}: implicit")))
+                }
+            }
+        }
     }
 
     fn with_stepper(stepper: SloshStepper) -> Result<Self, IntegratorError> {
