@@ -857,7 +857,8 @@ class SloshScene:
     invariants"). ``[solver]``:
     ``t_end`` (s), ``step`` (s), ``frame`` (``"inertial"`` or ``"tank"``), ``contact_stiffness_factor``
     (wall stiffness as a multiple of the default penalty law, 0.1 to 1000), ``stepper``
-    (``"implicit"``, default; ``"explicit"``; ``"auto"``: see :func:`railslosh.slosh.run`). ``[outputs]``: ``netcdf``, ``plots``.
+    (``"implicit"``, default; ``"explicit"``; ``"auto"``: see :func:`railslosh.slosh.run`).
+    ``[outputs]``: ``netcdf``, ``plots``.
     ``[maneuver]``: ``type`` =
 
     * ``"lane_change"``: lateral (y) displacement ``offset`` (m, default 3.66 = 12 ft) over ``length``

@@ -63,7 +63,8 @@ fn median(mut v: Vec<f64>) -> f64 {
 
 /// The stable-step estimate at rest, and what sets it (`probe` argument).
 fn probe(counts: [usize; 3]) {
-    let variants: [(&str, fn(&mut SloshSystem)); 4] = [
+    type Adjust = fn(&mut SloshSystem);
+    let variants: [(&str, Adjust); 4] = [
         ("as built", |_| {}),
         ("no penalty damping", |s| s.body.fluid.bulk_damping = 0.0),
         ("no contact damping", |s| s.contact.law.damping = 0.0),
