@@ -430,24 +430,71 @@ def test_lane_change_moves_the_tank_by_the_offset_and_stops_it():
     assert abs(y[-1]) < 0.02 and y.max() == pytest.approx(3.0, rel=5e-3)
 
 
-@pytest.mark.parametrize("shape", ["half_round", "trapezoid"])
-def test_slow_bump_is_followed_quasi_statically_and_the_tank_comes_to_rest(shape):
-    """At crawling speed the low-pass suspension follows the road: the doubly integrated
-    acceleration reaches the bump height and returns to zero with zero velocity."""
-    doc = _set_dotted(SLOSH_BASE, "maneuver", {"type": "bump", "shape": shape, "height": 0.2, "speed": 0.1})
-    doc["maneuver"]["t0"] = 0.5
-    doc["solver"]["t_end"] = 20.0
-    sc = scene.load_scene(doc)
-    pts = np.array(sc.motion().acceleration["z"])
-    t = np.linspace(0.0, 20.0, 200_001)  # the trapezoid (1.4 m) is crossed in 14 s
+def _integrate_twice(pts: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     a = np.interp(t, pts[:, 0], pts[:, 1])
     v = np.concatenate([[0.0], np.cumsum(0.5 * (a[1:] + a[:-1]) * np.diff(t))])
-    z = np.concatenate([[0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) * np.diff(t))])
-    assert z.max() == pytest.approx(0.2, rel=0.03)
-    # 3 s (> 10 time constants 1/(zeta w)) after the bump the tank is back down, at rest
-    length = 0.4 if shape == "half_round" else (4 + 2 + 1) * 0.2
-    k = np.searchsorted(t, 0.5 + length / 0.1 + 3.0)
-    assert abs(z[k]) < 2e-3 and abs(v[k]) < 1e-3 and abs(a[k]) < 1e-3
+    x = np.concatenate([[0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) * np.diff(t))])
+    return x, v, a
+
+
+@pytest.mark.parametrize("shape", ["half_round", "trapezoid"])
+def test_slow_bump_is_followed_quasi_statically_and_the_tank_comes_to_rest(shape):
+    """At crawling speed each axle's suspension follows the road: the tank midway between the
+    axles heaves by half the bump height and pitches by height / wheelbase while one axle is on
+    the bump, and comes back to rest, level, after the rear axle has left it (the two-axle
+    vehicle of rail_mbs::maneuvers)."""
+    speed, t0, wb = 0.25, 0.5, 3.9
+    doc = _set_dotted(SLOSH_BASE, "maneuver", {"type": "bump", "shape": shape, "height": 0.2, "speed": speed})
+    doc["maneuver"]["t0"] = t0
+    length = 2 * np.sqrt(0.73**2 - 0.53**2) if shape == "half_round" else (4 + 2 + 1) * 0.2
+    t_end = t0 + (length + wb) / speed + 3.0  # 3 s (> 10 time constants 1/(zeta w)) after the bump
+    doc["solver"]["t_end"] = t_end
+    sc = scene.load_scene(doc)
+    mo = sc.motion()
+    assert sc.maneuver["wheelbase"] == wb and mo.rotation_axis == (0.0, 1.0, 0.0)
+    t = np.linspace(0.0, t_end, 400_001)
+    z, v, a = _integrate_twice(np.array(mo.acceleration["z"]), t)
+    th, _, _ = _integrate_twice(np.array(mo.angular_acceleration), t)
+    front = t < t0 + wb / speed  # only the front axle has reached the bump
+    assert z[front].max() == pytest.approx(0.1, rel=0.03)
+    assert np.abs(th[front]).max() == pytest.approx(0.2 / wb, rel=0.03)
+    assert abs(z[-1]) < 2e-3 and abs(v[-1]) < 1e-3 and abs(a[-1]) < 1e-3 and abs(th[-1]) < 1e-3
+
+
+def test_shipped_swri_scenes_run_the_cosimulation_maneuvers():
+    """One definition of seed 003's maneuvers (rail_mbs::maneuvers): each shipped SwRI scene's
+    prescribed motion is, sample for sample, the co-simulation's maneuver of the same name (the
+    scene's motion adds the jumps of the acceleration as pairs of samples at their times)."""
+    from railslosh import _core
+
+    mans = {m["name"]: m for m in _core.seed003_maneuvers(dt=1e-3, t_after=1.0, t_before=0.2)}
+    scenes = sorted((ROOT / "examples" / "scenes").glob("swri_*.toml"))
+    assert len(scenes) == 6
+
+    def same(samples, t, values, what):
+        pts = np.array(samples)
+        times, counts = np.unique(pts[:, 0], return_counts=True)
+        assert counts.max() <= 2 and np.all(np.diff(pts[:, 0]) >= 0), what
+        single = times[counts == 1]
+        ref = dict(zip(t.tolist(), values.tolist(), strict=True))
+        got = {float(a): float(b) for a, b in pts}
+        common = [x for x in single.tolist() if x in ref]
+        assert len(common) > 0.9 * np.count_nonzero(t <= pts[-1, 0]), what
+        # equal up to the rounding of the scenes' dimensions (1.2192 m against 4 * 12 in)
+        np.testing.assert_allclose([got[x] for x in common], [ref[x] for x in common], rtol=1e-9, atol=1e-9)
+
+    for path in scenes:
+        sc = scene.load_scene(path)
+        m = mans[path.stem.removeprefix("swri_").removeprefix("bump_")]
+        mo = sc.motion()
+        for i, ax in enumerate("xyz"):
+            if len(mo.acceleration[ax]) == 1:  # an axis the maneuver does not move along
+                assert np.all(m["pose_acceleration"][:, i] == 0.0), (path.stem, ax)
+            else:
+                same(mo.acceleration[ax], m["t"], m["pose_acceleration"][:, i], (path.stem, ax))
+        axis = np.array(mo.rotation_axis)
+        same(mo.angular_acceleration, m["t"], m["pose_angular_acceleration"] @ axis, (path.stem, "rotation"))
+        assert mo.angular_acceleration[-1][0] >= sc.t_end
 
 
 def test_all_examples_load_with_quick_overrides():

@@ -1,7 +1,7 @@
 """Type stubs of the Rust extension module ``railslosh._core``."""
 
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from typing import Any, final
 
 import numpy as np
@@ -433,4 +433,8 @@ class SloshParticipant:
     @property
     def stats(self) -> dict[str, Any]: ...
 
-def seed003_maneuvers(dt: float = 0.005, t_after: float = 2.0, gravity: float = 9.81) -> list[dict[str, Any]]: ...
+def seed003_maneuvers(
+    dt: float = 0.005, t_after: float = 2.0, gravity: float = 9.81, t_before: float = 0.5
+) -> list[dict[str, Any]]: ...
+def maneuver_defaults() -> dict[str, dict[str, float]]: ...
+def maneuver_motion(spec: Mapping[str, Any], t0: float, t_end: float, dt: float = 1e-3) -> dict[str, Any]: ...

@@ -861,14 +861,19 @@ class SloshScene:
     ``[outputs]``: ``netcdf``, ``plots``.
     ``[maneuver]``: ``type`` =
 
+    Lane changes and bumps are built by the one maneuver library, ``rail_mbs::maneuvers`` (the
+    co-simulation's seed 003 maneuvers are the same motions; its docs give the formulas):
+
     * ``"lane_change"``: lateral (y) displacement ``offset`` (m, default 3.66 = 12 ft) over ``length``
       (m, default 30.5 = 100 ft) at ``speed`` (m/s) or ``speed_mph``/``speed_kmh``; acceleration
       ``a(t) = 2 pi offset / T^2 sin(2 pi (t - t0) / T)``, ``T = length / speed`` (zero velocity at both
       ends); ``double = true`` (default) returns to the original lane after ``hold`` m (default 15.2);
+      the tank heading (yaw about z) follows the path;
     * ``"bump"``: ``shape = "half_round" | "trapezoid"`` of ``height`` (m) or ``height_in``, crossed at
-      ``speed``; the tank's vertical motion is the road profile filtered by a second-order
-      low-pass standing for the suspension (``suspension_frequency`` Hz, default 2.0;
-      ``suspension_damping`` ratio, default 0.3); a trapezoid has ``ramp_up``, ``top`` and
+      ``speed`` by a two-axle vehicle (``wheelbase`` m, default 3.9; ``wheel_radius`` m, default 0.53,
+      rolling over a half-round bump) with a quarter-car suspension per axle
+      (``suspension_frequency`` Hz, default 2.0; ``suspension_damping`` ratio, default 0.3); the tank,
+      midway between the axles, heaves and pitches; a trapezoid has ``ramp_up``, ``top`` and
       ``ramp_down`` lengths (m; defaults 4, 2 and 1 times the height: asymmetric, steep exit);
     * ``"pulse"``: ``axis``, ``acceleration`` (m/s^2), ``t0``, ``t1``, ``ramp`` (s);
     * ``"samples"``: ``x``, ``y``, ``z`` = ``[[t, a], ...]`` piecewise-linear accelerations.
@@ -1002,6 +1007,8 @@ def _maneuver(m: Mapping[str, Any], t_end: float) -> dict[str, Any]:
             "height_in",
             "suspension_frequency",
             "suspension_damping",
+            "wheelbase",
+            "wheel_radius",
             "ramp_up",
             "top",
             "ramp_down",
@@ -1011,11 +1018,13 @@ def _maneuver(m: Mapping[str, Any], t_end: float) -> dict[str, Any]:
     }[kind]
     _check_keys(m, "maneuver", ("type", "t0", *keys))
     out: dict[str, Any] = {"type": kind, "t0": _number(m.get("t0", 0.2), "maneuver.t0", 0.0, 600.0, "s")}
+    defaults = _maneuver_defaults()
     if kind == "lane_change":
+        d = defaults["lane_change"]
         out["speed"] = _speed(m, "maneuver")
-        out["offset"] = _number(m.get("offset", 3.66), "maneuver.offset", 0.1, 20.0, "m")
-        out["length"] = _number(m.get("length", 30.5), "maneuver.length", 1.0, 1000.0, "m")
-        out["hold"] = _number(m.get("hold", 15.2), "maneuver.hold", 0.0, 1000.0, "m")
+        out["offset"] = _number(m.get("offset", d["offset"]), "maneuver.offset", 0.1, 20.0, "m")
+        out["length"] = _number(m.get("length", d["length"]), "maneuver.length", 1.0, 1000.0, "m")
+        out["hold"] = _number(m.get("hold", d["hold"]), "maneuver.hold", 0.0, 1000.0, "m")
         dbl = m.get("double", True)
         if not isinstance(dbl, bool):
             raise _fail("maneuver.double", dbl, "true or false")
@@ -1031,14 +1040,17 @@ def _maneuver(m: Mapping[str, Any], t_end: float) -> dict[str, Any]:
             else _number(m["height_in"], "maneuver.height_in", 0.04, 40.0, "in") * INCH
         )
         out["height"] = h
+        d = defaults["bump"]
         out["suspension_frequency"] = _number(
-            m.get("suspension_frequency", 2.0), "maneuver.suspension_frequency", 0.2, 50.0, "Hz"
+            m.get("suspension_frequency", d["suspension_frequency"]), "maneuver.suspension_frequency", 0.2, 50.0, "Hz"
         )
         out["suspension_damping"] = _number(
-            m.get("suspension_damping", 0.3), "maneuver.suspension_damping", 0.01, 2.0, ""
+            m.get("suspension_damping", d["suspension_damping"]), "maneuver.suspension_damping", 0.01, 2.0, ""
         )
+        out["wheelbase"] = _number(m.get("wheelbase", d["wheelbase"]), "maneuver.wheelbase", 0.5, 30.0, "m")
+        out["wheel_radius"] = _number(m.get("wheel_radius", d["wheel_radius"]), "maneuver.wheel_radius", 0.1, 2.0, "m")
         if out["shape"] == "trapezoid":
-            for k, f in (("ramp_up", 4.0), ("top", 2.0), ("ramp_down", 1.0)):
+            for k, f in defaults["trapezoid"].items():
                 out[k] = _number(m.get(k, f * h), f"maneuver.{k}", 0.0 if k == "top" else 0.01, 100.0, "m")
         else:
             for k in ("ramp_up", "top", "ramp_down"):
@@ -1071,61 +1083,28 @@ def _maneuver(m: Mapping[str, Any], t_end: float) -> dict[str, Any]:
     return out
 
 
-def _lane_change_samples(m: Mapping[str, Any], t_end: float) -> list[tuple[float, float]]:
-    T = m["length"] / m["speed"]
-    amp = 2.0 * math.pi * m["offset"] / T**2
-    n = 40
-    pts: list[tuple[float, float]] = [(0.0, 0.0)] if m["t0"] > 0 else []
-    starts = [(m["t0"], 1.0)]
-    if m["double"]:
-        starts.append((m["t0"] + T + m["hold"] / m["speed"], -1.0))
-    for t0, sign in starts:
-        for i in range(n + 1):
-            t = t0 + T * i / n
-            if pts and t <= pts[-1][0]:
-                continue
-            pts.append((t, sign * amp * math.sin(2.0 * math.pi * i / n)))
-    if pts[-1][0] < t_end:
-        pts.append((t_end + 1.0, 0.0))
-    return pts
+@functools.cache
+def _maneuver_defaults() -> dict[str, dict[str, float]]:
+    """Defaults of the ``[maneuver]`` keys, from the one maneuver library (``rail_mbs::maneuvers``)."""
+    from railslosh import _core
 
-
-def _road_profile(m: Mapping[str, Any], x: np.ndarray) -> np.ndarray:
-    h = m["height"]
-    if m["shape"] == "half_round":
-        r = np.clip(x - h, -h, h)  # bump of radius h centred at x = h
-        return np.where((x > 0) & (x < 2 * h), np.sqrt(np.maximum(h * h - r * r, 0.0)), 0.0)
-    up, top, down = m["ramp_up"], m["top"], m["ramp_down"]
-    return np.interp(x, [0.0, up, up + top, up + top + down], [0.0, h, h, 0.0], left=0.0, right=0.0)
-
-
-def _bump_samples(m: Mapping[str, Any], t_end: float) -> list[tuple[float, float]]:
-    """Vertical acceleration of the tank crossing the bump: the road profile under the wheel,
-    filtered by the suspension taken as a second-order low-pass ``w^2 / (s^2 + 2 zeta w s + w^2)``
-    (frequency f, damping ratio zeta), sampled every 1 ms."""
-    from scipy import signal
-
-    w = 2.0 * math.pi * m["suspension_frequency"]
-    zeta = m["suspension_damping"]
-    dt = 2e-4
-    t = np.arange(0.0, t_end + dt, dt)
-    zr = _road_profile(m, m["speed"] * (t - m["t0"]))
-    sys = signal.StateSpace([[0.0, 1.0], [-w * w, -2.0 * zeta * w]], [[0.0], [w * w]], [[1.0, 0.0]], [[0.0]])
-    _, _, x = signal.lsim(sys, zr, t, interp=True)
-    a = -w * w * x[:, 0] - 2.0 * zeta * w * x[:, 1] + w * w * zr  # exact state acceleration
-    k = max(1, round(0.001 / dt))
-    idx = np.arange(0, len(t), k)
-    return [(float(t[i]), float(a[i])) for i in idx] + [(float(t[-1]) + 1.0, 0.0)]
+    return _core.maneuver_defaults()
 
 
 def _motion(m: Mapping[str, Any], t_end: float) -> Any:
     from railslosh import slosh
 
     mo = slosh.Motion()
-    if m["type"] == "lane_change":
-        mo.acceleration["y"] = _lane_change_samples(m, t_end)
-    elif m["type"] == "bump":
-        mo.acceleration["z"] = _bump_samples(m, t_end)
+    if m["type"] in ("lane_change", "bump"):
+        # one definition (rail_mbs::maneuvers), shared with the co-simulation: accelerations
+        # and the rotation (heading of a lane change, pitch over a bump) sampled every 1 ms
+        from railslosh import _core
+
+        d = _core.maneuver_motion(m, m["t0"], t_end)
+        mo.acceleration = {ax: [(float(t), float(a)) for t, a in pts] for ax, pts in d["acceleration"].items()}
+        if d["rotation_axis"] is not None:
+            mo.rotation_axis = tuple(float(x) for x in d["rotation_axis"])
+            mo.angular_acceleration = [(float(t), float(a)) for t, a in d["angular_acceleration"]]
     elif m["type"] == "pulse":
         mo.pulse(m["axis"], m["acceleration"], m["t0"], m["t1"], ramp=m["ramp"])
     else:

@@ -10,7 +10,7 @@
 //!
 //! CSV columns: t, the tank-frame input (ax ay az wx wy wz wdx wdy wdz gx gy gz), the
 //! loads on the tank about the tank origin (Fx Fy Fz Mx My Mz, tank axes), the fluid
-//! centre of mass (cx cy cz, tank frame). Maneuver definitions: `rail_mbs::cosim::maneuvers`.
+//! centre of mass (cx cy cz, tank frame). Maneuver definitions: `rail_mbs::maneuvers` (the same motions as the shipped `swri_*` scenes).
 use std::io::Write;
 
 use ancf_core::constitutive::Rheology;

@@ -84,9 +84,35 @@ fn probe(counts: [usize; 3]) {
     }
 }
 
+/// The stable-step estimates along the explicit run (`trace` argument).
+fn trace(counts: [usize; 3]) {
+    let sys = system(counts);
+    let (q, v) = sys.initial_state(0.0);
+    let m_s = sys.body.scalar_mass().clone();
+    let mut e = rail_mbs::integrator::Explicit::new(sys, &m_s, 0.0, q, v, ExplicitParams::default()).unwrap();
+    for k in 1..=16 {
+        let s0 = e.stats().steps;
+        e.advance_to(0.25 * k as f64).unwrap();
+        let est = e.last_estimate().unwrap();
+        let fresh = e.estimate_stable_step(200).unwrap();
+        println!(
+            "{{\"t\": {:.2}, \"steps\": {}, \"running_critical\": {:.3e}, \"xi\": {:.2}, \"converged_critical\": {:.3e}, \"xi200\": {:.2}}}",
+            e.t(),
+            e.stats().steps - s0,
+            est.critical,
+            est.damping_ratio,
+            fresh.critical,
+            fresh.damping_ratio
+        );
+    }
+}
+
 fn main() {
     if std::env::args().any(|a| a == "probe") {
         return probe([2, 6, 2]);
+    }
+    if std::env::args().any(|a| a == "trace") {
+        return trace([2, 6, 2]);
     }
     let args: Vec<usize> = std::env::args().skip(1).filter_map(|a| a.parse().ok()).collect();
     let counts = if args.len() >= 3 { [args[0], args[1], args[2]] } else { [2, 6, 2] };

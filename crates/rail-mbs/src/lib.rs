@@ -2,6 +2,8 @@
 //!
 //! Modules are grouped by physics:
 //! - [`cosim`]: the slosh model as a co-simulation participant (seed 003);
+//! - [`maneuvers`]: seed 003's tank manoeuvres (lane changes, bumps), the one definition used
+//!   by the prescribed-motion scenes and the co-simulation;
 //! - [`invariants`]: run-time checks of every fluid run (containment, energy, element validity);
 //! - [`integrator`]: the sparse implicit HHT-α integrator (faer sparse LU) that advances
 //!   rigid and ANCF bodies together;
@@ -13,6 +15,7 @@
 pub mod cosim;
 pub mod integrator;
 pub mod invariants;
+pub mod maneuvers;
 pub mod mbs;
 pub mod profile;
 pub mod slosh;

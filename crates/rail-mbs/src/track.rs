@@ -58,6 +58,8 @@ pub const GRAVITY: f64 = 9.80665;
 pub const FOOT: f64 = 0.3048;
 /// One inch in metres.
 pub const INCH: f64 = 0.0254;
+/// One mile per hour in metres per second.
+pub const MPH: f64 = 0.44704;
 /// Radius, in feet, of a 1° curve with the arc definition (100 ft of arc per degree).
 pub const ARC_DEGREE_RADIUS_FT: f64 = 5_729.577_951_308_232;
 

@@ -321,17 +321,26 @@ impl PySloshParticipant {
     }
 }
 
-/// Seed 003's six maneuvers as prescribed tank motions (`rail_mbs::cosim::maneuvers`,
-/// dimensions documented there), sampled every `dt` s with `t_after` s of free sloshing:
+/// Seed 003's six maneuvers as prescribed tank motions (`rail_mbs::maneuvers`, dimensions
+/// documented there; the same motions as the shipped `swri_*` scenes), each starting after
+/// `t_before` s, sampled every `dt` s with `t_after` s of free sloshing:
 /// a list of dicts with `name` and arrays `t` (n), tank-frame `acceleration`,
 /// `angular_velocity`, `angular_acceleration`, `gravity` (n×3), and the global pose
 /// `position`, `velocity`, `pose_acceleration`, `pose_angular_velocity`,
 /// `pose_angular_acceleration` (n×3), `rotation` (n×3×3).
 #[pyfunction]
-#[pyo3(signature = (dt=0.005, t_after=2.0, gravity=9.81))]
-fn seed003_maneuvers<'py>(py: Python<'py>, dt: f64, t_after: f64, gravity: f64) -> PyResult<Vec<Bound<'py, PyDict>>> {
+#[pyo3(signature = (dt=0.005, t_after=2.0, gravity=9.81, t_before=0.5))]
+fn seed003_maneuvers<'py>(
+    py: Python<'py>,
+    dt: f64,
+    t_after: f64,
+    gravity: f64,
+    t_before: f64,
+) -> PyResult<Vec<Bound<'py, PyDict>>> {
+    use rail_mbs::maneuvers::ManeuverSpec;
     let mans = run(py, move || {
-        let mans = rail_mbs::cosim::maneuvers::seed003_maneuvers(dt, t_after)?;
+        let mans =
+            ManeuverSpec::seed003().iter().map(|m| m.build(t_before, t_after, dt)).collect::<Result<Vec<_>, _>>()?;
         mans.into_iter()
             .map(|m| {
                 let tf = m.tank_frame(gravity)?;

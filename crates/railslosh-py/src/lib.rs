@@ -12,6 +12,7 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 
 mod bench;
 mod cosim;
+mod maneuvers;
 mod rail;
 mod vehicle;
 
@@ -734,5 +735,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     rail::register(m)?;
     vehicle::register(m)?;
     cosim::register(m)?;
+    maneuvers::register(m)?;
     Ok(())
 }

@@ -22,8 +22,9 @@
 //! PoseInput::rotation_from_quaternion([w, x, y, z]) -> Result<[[f64; 3]; 3], CosimError>
 //! PoseInput::to_tank_frame(&self, gravity: f64) -> Result<TankFrameSample, CosimError>
 //! Loads { force: [f64; 3], moment: [f64; 3] }
-//! maneuvers::{lane_change, half_round_bump, trapezoidal_bump, seed003_maneuvers, Maneuver,
-//!             BumpVehicle}
+//! maneuvers (= crate::maneuvers)::{lane_change, lane_change_course, half_round_bump,
+//!             trapezoidal_bump, bump, seed003_maneuvers, Maneuver, ManeuverSpec,
+//!             LaneChangeCourse, BumpProfile, BumpVehicle}
 //! ```
 //!
 //! # Conventions (docs/frames.md)
@@ -62,8 +63,11 @@
 //!   mass the tank carries when the fluid moves rigidly with it (an upper bound of the
 //!   sloshing added mass; masters use it for added-mass splitting).
 
-pub mod maneuvers;
 mod participant;
+
+/// The manoeuvre library lives in [`crate::maneuvers`] (one definition for the co-simulation
+/// examples and the prescribed-motion scenes); re-exported here under its old path.
+pub use crate::maneuvers;
 
 pub use participant::{
     CosimError, Loads, ParticipantState, PoseInput, SloshParticipant, SloshParticipantConfig, TankMotionInput,

@@ -21,15 +21,23 @@ pub struct PiecewiseAcceleration {
 }
 
 impl PiecewiseAcceleration {
-    /// From samples (t_i, a_i) with strictly increasing times, starting at rest at value 0
-    /// at the first time. Before the first sample the signal is 0.
+    /// From samples (t_i, a_i) with increasing times, starting at rest at value 0 at the first
+    /// time. Before the first sample the signal is 0. A time given twice in a row is a jump of
+    /// the acceleration there (the first value is the limit from the left, the second from the
+    /// right; the integrals stay continuous), so piecewise-smooth signals are represented
+    /// without the O(Δa·Δt) error of sampling across the jump.
     pub fn new(field: &str, samples: &[(f64, f64)]) -> Result<Self> {
         if samples.is_empty() {
             return Err(invalid(field, "[]", "at least one (time, acceleration) sample"));
         }
         for (i, w) in samples.windows(2).enumerate() {
-            if w[1].0.partial_cmp(&w[0].0) != Some(std::cmp::Ordering::Greater) {
-                return Err(invalid(&format!("{field}[{}].time", i + 1), w[1].0, "strictly increasing times"));
+            let repeated = w[1].0 == w[0].0 && (i == 0 || samples[i - 1].0 < w[0].0);
+            if !(w[1].0 > w[0].0 || repeated) {
+                return Err(invalid(
+                    &format!("{field}[{}].time", i + 1),
+                    w[1].0,
+                    "increasing times (a time at most twice in a row: a jump)",
+                ));
             }
         }
         if samples.iter().any(|(t, a)| !t.is_finite() || !a.is_finite()) {
@@ -58,6 +66,11 @@ impl PiecewiseAcceleration {
         Self::new("pulse", &[(t0, 0.0), (t0 + ramp, a), (t1 - ramp, a), (t1, 0.0)])
     }
 
+    /// The samples (t_i, a_i) it was built from.
+    pub fn samples(&self) -> impl Iterator<Item = (f64, f64)> + '_ {
+        self.times.iter().copied().zip(self.acc.iter().copied())
+    }
+
     /// The signal that is zero for all time.
     pub fn zero() -> Self {
         Self::new("zero", &[(0.0, 0.0)]).expect("valid")
@@ -69,9 +82,10 @@ impl PiecewiseAcceleration {
         if t <= self.times[0] {
             return (0.0, 0.0, 0.0);
         }
-        let i = match self.times.iter().position(|&x| x > t) {
-            Some(i) => i - 1,
-            None => {
+        // first knot after t (binary search: maneuvers carry thousands of samples)
+        let i = match self.times.partition_point(|&x| x <= t) {
+            k if k < n => k - 1,
+            _ => {
                 let (a, v, p) = (self.acc[n - 1], self.vel[n - 1], self.pos[n - 1]);
                 let s = t - self.times[n - 1];
                 return (p + v * s + 0.5 * a * s * s, v + a * s, a);
@@ -255,6 +269,19 @@ mod tests {
         }
         let (p, vv, a) = s.eval(5.0);
         assert!((vv - v).abs() < 1e-8 && (p - x).abs() < 1e-7 && (a + 1.0).abs() < 1e-15, "{p} {x} {vv} {v}");
-        assert!(PiecewiseAcceleration::new("a", &[(1.0, 0.0), (1.0, 1.0)]).is_err());
+        assert!(PiecewiseAcceleration::new("a", &[(1.0, 0.0), (0.5, 1.0)]).is_err());
+    }
+
+    #[test]
+    fn a_repeated_time_is_an_exact_jump() {
+        // a = 0 until 1, then 2: v = 2 (t - 1), x = (t - 1)² after the jump
+        let s = PiecewiseAcceleration::new("a", &[(0.0, 0.0), (1.0, 0.0), (1.0, 2.0), (3.0, 2.0)]).unwrap();
+        assert_eq!(s.eval(0.5), (0.0, 0.0, 0.0));
+        assert_eq!(s.eval(1.0).2, 2.0);
+        let (x, v, a) = s.eval(2.5);
+        assert!((x - 2.25).abs() < 1e-14 && (v - 3.0).abs() < 1e-14 && a == 2.0, "{x} {v} {a}");
+        // a time three times in a row is refused
+        let e = PiecewiseAcceleration::new("a", &[(0.0, 0.0), (1.0, 0.0), (1.0, 2.0), (1.0, 3.0)]).unwrap_err();
+        assert!(e.to_string().contains("a[3].time"), "{e}");
     }
 }
