@@ -273,12 +273,11 @@ pub fn lane_change_course(
         }
     };
     let poses = times.iter().map(|&t| pose(t, 0.0)).collect();
-    let jumps = segments
-        .iter()
-        .flat_map(|&(t0, _)| [t0, t0 + tl])
-        .filter(|&t| t > 0.0)
-        .map(|t| Jump { time: t, before: pose(t, -1.0), after: pose(t, 1.0) })
-        .collect();
+    // starts and ends of the lane changes, once each (with `hold = 0` the first end is the
+    // second start)
+    let mut kinks: Vec<f64> = segments.iter().flat_map(|&(t0, _)| [t0, t0 + tl]).filter(|&t| t > 0.0).collect();
+    kinks.dedup();
+    let jumps = kinks.into_iter().map(|t| Jump { time: t, before: pose(t, -1.0), after: pose(t, 1.0) }).collect();
     Ok(Maneuver { name: format!("lane_change_{:.0}mph", speed / MPH), times, poses, jumps })
 }
 
@@ -643,6 +642,13 @@ mod tests {
         assert!((m.times.last().unwrap() - end).abs() <= 1e-3, "{} vs {end}", m.times.last().unwrap());
         let cut = m.until(1.0);
         assert!(*cut.times.last().unwrap() >= 1.0 && cut.times[cut.times.len() - 2] < 1.0);
+        // no hold: straight back (the end of the first lane change is the start of the second)
+        let back = LaneChangeCourse { hold: Some(0.0), ..c };
+        let m = lane_change_course(v, &back, 0.2, 0.5, 1e-3).unwrap();
+        assert_eq!(m.jumps.len(), 3);
+        let pm = m.prescribed_motion().unwrap();
+        let (y, yd, _) = pm.translation[1].eval(*m.times.last().unwrap());
+        assert!(y.abs() < 1e-4 && yd.abs() < 1e-6, "{y} {yd}");
     }
 
     #[test]
