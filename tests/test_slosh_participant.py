@@ -122,3 +122,18 @@ def test_settle_keeps_the_clock_and_loads_the_walls(parts):
     assert abs(f[2] + w) < 0.02 * w
     with pytest.raises(ValueError, match="`duration`"):
         p.settle(0.0, {})
+
+
+def test_the_participant_reports_its_invariant_margins_with_a_balanced_energy_account(parts):
+    """Issue 16 §1 for the co-simulation participant: every window checks containment, element
+    validity and the tank-frame energy balance; the worst margins are reported as a slosh run's."""
+    p = make(parts)
+    p.settle(0.3, {})
+    push = {"acceleration": [0.0, 0.3 * G, 0.0]}
+    for k in range(40):
+        p.advance(0.01 * (k + 1), push if k < 15 else {}, push if k < 14 else {})
+    m = p.margins
+    assert set(m) >= {"worst_gap", "gap_limit", "worst_energy_error", "min_volume_ratio", "dissipated"}
+    assert 0.0 <= m["worst_gap"] < m["gap_limit"] and m["min_volume_ratio"] > 0.5
+    assert m["worst_energy_error"] is not None and m["worst_energy_error"] <= 1e-3
+    assert m["dissipated"] > 0.0

@@ -263,6 +263,13 @@ impl InvariantMonitor {
         self.margins
     }
 
+    /// Starts a new energy account from the next state checked (its energy becomes E₀, no
+    /// work before it), keeping the margins: for a run whose input was reset (a new initial
+    /// input, a settled state with its clock set back, a restored state).
+    pub fn restart_energy(&mut self) {
+        (self.e0, self.last, self.input_work, self.abs_work, self.max_kinetic) = (None, None, 0.0, 0.0, 0.0);
+    }
+
     /// Work put into the liquid so far (J).
     pub fn input_work(&self) -> f64 {
         self.input_work

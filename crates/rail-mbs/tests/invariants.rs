@@ -8,6 +8,7 @@ use ancf_core::contact::{WallContact, WallContactLaw};
 use ancf_core::element::QuadratureOptions;
 use ancf_core::mesh::box_mesh;
 use ancf_core::tank::{TankGeometry, TankShape};
+use rail_mbs::cosim::{CosimError, SloshParticipant, SloshParticipantConfig, TankFrameSample, TankMotionInput};
 use rail_mbs::integrator::{FailureCause, IntegratorError, SystemError};
 use rail_mbs::slosh::validate::{liquid, slosh_params};
 use rail_mbs::slosh::{PiecewiseAcceleration, PrescribedMotion, SloshFrame, SloshRun, SloshSystem};
@@ -81,6 +82,72 @@ fn negative_contact_damping_injects_energy_and_stops_with_the_energy_error() {
     // everything computed is kept, up to and including the violating sample
     assert_eq!(err.record.t.last(), Some(t));
     assert!(err.record.energy_error.iter().rev().skip(1).all(|e| *e <= *limit));
+}
+
+/// The co-simulation participant on the `box_run` setup (tank-frame formulation).
+fn box_participant() -> SloshParticipant {
+    let lo = [-0.5 * L[0], -0.5 * L[1], 0.0];
+    let mesh = box_mesh(lo, L, [2, 4, 2]).unwrap();
+    let fluid = liquid(RHO, Rheology::Newtonian { viscosity: 1e-3 }, L[2], L[2] / 2.0).unwrap();
+    let geo = TankGeometry::new(TankShape::Box { min: lo, max: [0.5 * L[0], 0.5 * L[1], 0.3] }, vec![]).unwrap();
+    let mut c = SloshParticipantConfig::new(mesh, fluid, geo);
+    c.quadrature = QuadratureOptions { viscous: 4, penalty: 4, mass: 4 };
+    c.contact = Some(WallContactLaw::default_for(RHO, G, L[2]));
+    c.hht = slosh_params();
+    c.h_max = 0.005;
+    c.gravity = G;
+    SloshParticipant::new(c).unwrap()
+}
+
+/// Tank-frame input of `box_run`'s pulse (0.3 g lateral on [0.05, 0.45] s, 0.02 s ramps) at t.
+fn pulse_input(t: f64) -> TankMotionInput {
+    let (_, _, a) = PiecewiseAcceleration::pulse(0.3 * G, 0.05, 0.45, 0.02).unwrap().eval(t);
+    TankMotionInput::TankFrame(TankFrameSample { acceleration: [0.0, a, 0.0], ..TankFrameSample::at_rest(G) })
+}
+
+/// Advances `p` in 5 ms windows (the pulse's knots are window ends, so the linear input
+/// within each window is exact) to `t_end`.
+fn advance_pulse(p: &mut SloshParticipant, t_end: f64) -> Result<(), CosimError> {
+    while p.time() < t_end - 1e-9 {
+        let (t0, t1) = (p.time(), (p.time() + 0.005).min(t_end));
+        p.advance(t1, &pulse_input(t0), &pulse_input(t1))?;
+    }
+    Ok(())
+}
+
+#[test]
+fn the_cosimulation_participant_keeps_the_same_energy_account_as_a_tank_frame_run() {
+    let mut p = box_participant();
+    advance_pulse(&mut p, 1.0).unwrap();
+    let m = p.margins();
+    assert!(m.worst_energy_error < 1e-3 && m.worst_energy_error.is_finite(), "ε = {}", m.worst_energy_error);
+    assert!(m.dissipated > 0.0 && m.worst_gap < 0.25 * m.gap_limit && m.min_volume_ratio > 0.9, "{m:?}");
+    // the same physics through SloshRun in the tank frame: the same energy dissipated
+    let mut run = box_run(SloshFrame::Tank, 0.3 * G, |_| {});
+    run.run_to(1.0, 0.005).unwrap();
+    let d = run.margins().dissipated;
+    assert!((m.dissipated - d).abs() < 0.05 * d, "participant {} vs run {d}", m.dissipated);
+}
+
+#[test]
+fn an_energy_creating_participant_stops_with_the_energy_error_and_rolls_back_its_window() {
+    let mut p = box_participant();
+    p.system_mut().contact.law.damping *= -20.0; // as in the SloshRun test above
+    let err = loop {
+        let t0 = p.time();
+        assert!(t0 < 2.0, "energy creation must stop the participant");
+        if let Err(e) = advance_pulse(&mut p, t0 + 0.005) {
+            assert_eq!(p.time(), t0, "the failed window is rolled back");
+            break e;
+        }
+    };
+    let CosimError::Integrator { source, .. } = &err else { panic!("{err}") };
+    assert_eq!(source.cause(), FailureCause::EnergyGrowth, "{err}");
+    let IntegratorError::System { source: SystemError::EnergyGrowth { relative, limit, .. }, .. } = source.root()
+    else {
+        panic!("{err}")
+    };
+    assert!(relative > limit, "{err}");
 }
 
 #[test]

@@ -301,6 +301,13 @@ impl PySloshParticipant {
     fn reference_point<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         PyArray1::from_vec(py, self.inner.reference_point().to_vec())
     }
+    /// Worst run-time invariant margins so far (dict as a slosh run's `margins`: worst gap and
+    /// its limit, smallest volume ratio, worst energy error of the tank-frame energy account,
+    /// energy dissipated); a window that breaks an invariant raises and is rolled back.
+    #[getter]
+    fn margins<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        crate::margins_dict(py, &self.inner.margins())
+    }
     /// Largest integrator step (s).
     #[getter]
     fn h_max(&self) -> f64 {

@@ -11,6 +11,7 @@ use ancf_core::tank::TankGeometry;
 use nalgebra::{Matrix3, Vector3};
 
 use crate::integrator::{Checkpoint, Hht, HhtParams, IntegratorError, Stats};
+use crate::invariants::{InvariantMonitor, Margins};
 use crate::slosh::validate::slosh_params;
 use crate::slosh::{PrescribedMotion, SloshFrame, SloshSystem, TankFrameInput, TankFrameSample};
 
@@ -268,6 +269,9 @@ pub struct SloshParticipant {
     gravity: f64,
     h_max: f64,
     loads: Loads,
+    /// Run-time invariants: containment and element validity (also checked inside every
+    /// step by `SloshSystem::check_step`) and the tank-frame energy balance.
+    invariants: InvariantMonitor,
 }
 
 impl SloshParticipant {
@@ -299,6 +303,7 @@ impl SloshParticipant {
         )?;
         sys.tank_input = Some(TankFrameInput::constant(TankFrameSample::at_rest(config.gravity)));
         let (q, v) = sys.initial_state(config.t0);
+        let invariants = sys.invariant_monitor();
         let hht = Hht::new(sys, config.t0, q, v, config.hht).map_err(|e| integrator_error(config.t0, config.t0, e))?;
         let mut p = Self {
             hht,
@@ -307,9 +312,48 @@ impl SloshParticipant {
             gravity: config.gravity,
             h_max: config.h_max,
             loads: Loads::default(),
+            invariants,
         };
+        p.restart_energy().map_err(|e| integrator_error(config.t0, config.t0, e))?;
         p.loads = p.current_loads();
         Ok(p)
+    }
+
+    /// Checks the invariants of an accepted state with `monitor` (energy: tank frame, the
+    /// work of gravity and the pseudo-forces).
+    fn check_state(
+        monitor: &mut InvariantMonitor,
+        sys: &SloshSystem,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+    ) -> Result<(), IntegratorError> {
+        let kin = sys.contact_kinematics(t);
+        let stored = crate::invariants::stored_energy(&sys.body, &sys.contact, &kin, q);
+        let energy = sys.tank_frame_energy(t, q, v, stored);
+        monitor
+            .check(t, &sys.body, &sys.contact, &kin, q, energy)
+            .map(|_| ())
+            .map_err(|source| IntegratorError::System { t, source })
+    }
+
+    /// A new energy account from the current state (margins kept).
+    fn restart_energy(&mut self) -> Result<(), IntegratorError> {
+        self.invariants.restart_energy();
+        let (t, sys) = (self.hht.t(), self.hht.system());
+        Self::check_state(&mut self.invariants, sys, t, self.hht.q(), self.hht.v())
+    }
+
+    /// The slosh system, for tools and tests that change the model in place (the caller
+    /// answers for keeping it consistent; cached forces and Jacobians are invalidated).
+    pub fn system_mut(&mut self) -> &mut SloshSystem {
+        self.hht.system_mut()
+    }
+
+    /// The worst invariant margins so far (gap, volume ratio, energy error, dissipated
+    /// energy of the current energy account).
+    pub fn margins(&self) -> Margins {
+        self.invariants.margins()
     }
 
     /// The tank-frame form of an input (pose inputs are converted with this participant's
@@ -336,6 +380,7 @@ impl SloshParticipant {
         let (q, v) = (self.hht.q().to_vec(), self.hht.v().to_vec());
         self.hht.system_mut().tank_input = Some(TankFrameInput::constant(s));
         self.hht.reinitialize(t, &q, &v).map_err(|e| integrator_error(t, t, e))?;
+        self.restart_energy().map_err(|e| integrator_error(t, t, e))?;
         self.loads = self.current_loads();
         Ok(self.loads)
     }
@@ -359,11 +404,15 @@ impl SloshParticipant {
         self.hht.system_mut().tank_input = Some(TankFrameInput { t0, t1: t_end, start, end });
         let n = ((t_end - t0) / self.h_max).ceil().max(1.0);
         let h = (t_end - t0) / n;
-        if let Err(e) = self.hht.integrate_to(t_end, h) {
+        let mut monitor = self.invariants.clone();
+        let checked =
+            self.hht.integrate_checked(t_end, h, |sys, s| Self::check_state(&mut monitor, sys, s.t, s.q, s.v));
+        if let Err(e) = checked {
             let sys = self.hht.system().clone();
             self.hht = Hht::restore(sys, &saved, self.params).map_err(|e| integrator_error(t0, t0, e))?;
             return Err(integrator_error(t0, t_end, e));
         }
+        self.invariants = monitor;
         self.loads = self.current_loads();
         Ok(self.loads)
     }
@@ -382,6 +431,7 @@ impl SloshParticipant {
         cp.t = t0;
         let sys = self.hht.system().clone();
         self.hht = Hht::restore(sys, &cp, self.params).map_err(|e| integrator_error(t0, t0, e))?;
+        self.restart_energy().map_err(|e| integrator_error(t0, t0, e))?;
         self.loads = self.current_loads();
         Ok(self.loads)
     }
@@ -398,7 +448,8 @@ impl SloshParticipant {
         let hht = Hht::restore(sys, &state.checkpoint, self.params).map_err(|e| CosimError::State(e.to_string()))?;
         self.hht = hht;
         self.loads = state.loads;
-        Ok(())
+        let t = self.hht.t();
+        self.restart_energy().map_err(|e| integrator_error(t, t, e))
     }
 
     fn current_loads(&self) -> Loads {

@@ -467,6 +467,21 @@ impl<S: MechanicalSystem> Hht<S> {
         h: f64,
         mut observer: impl FnMut(StateRef<'_>),
     ) -> Result<(), IntegratorError> {
+        self.integrate_checked(t_end, h, |_, state| {
+            observer(state);
+            Ok(())
+        })
+    }
+
+    /// Like [`integrate_with`](Self::integrate_with), with a `check` of the system and every
+    /// accepted state that can stop the integration with an error (e.g. a run-time
+    /// invariant); the state is left where the check failed.
+    pub fn integrate_checked(
+        &mut self,
+        t_end: f64,
+        h: f64,
+        mut check: impl FnMut(&S, StateRef<'_>) -> Result<(), IntegratorError>,
+    ) -> Result<(), IntegratorError> {
         if !t_end.is_finite() || t_end < self.t {
             return Err(IntegratorError::InvalidParameter {
                 field: "t_end",
@@ -484,7 +499,7 @@ impl<S: MechanicalSystem> Hht<S> {
             if last && info.h == h_step {
                 self.t = t_end;
             }
-            observer(self.state());
+            check(&self.system, self.state())?;
         }
         Ok(())
     }

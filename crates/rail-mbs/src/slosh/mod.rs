@@ -488,12 +488,7 @@ impl SloshRun {
                 stored,
                 input_power: crate::invariants::wall_power(fg.into(), mg.into(), &state.kinematics),
             },
-            SloshFrame::Tank => EnergySample {
-                kinetic: body.kinetic_energy(v),
-                potential: 0.0,
-                stored,
-                input_power: sys.frame_power(t, q, v),
-            },
+            SloshFrame::Tank => sys.tank_frame_energy(t, q, v, stored),
         };
         let checked = self.invariants.check(t, body, &sys.contact, &kin, q, energy);
         let m = checked.as_ref().ok();

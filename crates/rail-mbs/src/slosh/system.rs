@@ -292,6 +292,20 @@ impl SloshSystem {
         p
     }
 
+    /// The energy account of a state in the tank-frame formulation, given its stored elastic
+    /// energy `stored` ([`crate::invariants::stored_energy`]): the kinetic energy of the
+    /// velocities relative to the tank, no gravitational term, and [`Self::frame_power`]
+    /// (gravity and pseudo-forces) as the input power. Used by tank-frame slosh runs and the
+    /// co-simulation participant.
+    pub fn tank_frame_energy(&self, t: f64, q: &[f64], v: &[f64], stored: f64) -> crate::invariants::EnergySample {
+        crate::invariants::EnergySample {
+            kinetic: self.body.kinetic_energy(v),
+            potential: 0.0,
+            stored,
+            input_power: self.frame_power(t, q, v),
+        }
+    }
+
     /// Contact load on the tank at a state (global components in the inertial formulation,
     /// tank components in the tank-frame formulation).
     pub fn contact_load(&self, t: f64, q: &[f64], v: &[f64]) -> ContactLoad {
