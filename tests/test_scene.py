@@ -12,7 +12,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import railslosh
-from railslosh import rail, scene
+from railslosh import rail, results, scene
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = sorted((ROOT / "examples" / "scenes").glob("*.toml"))
@@ -553,3 +553,27 @@ def test_wall_stiffness_factor_reaches_the_slosh_run():
     assert "contact_stiffness_factor" not in scene.load_scene(SLOSH_BASE).run_args()[1]
     with pytest.raises(ValueError, match=r"invalid parameter `solver.contact_stiffness_factor` = 0.0"):
         scene.load_scene(_set_dotted(SLOSH_BASE, "solver.contact_stiffness_factor", 0.0))
+
+
+def test_the_wall_damping_ratio_reaches_the_fluid_run_and_its_results():
+    """``[tank] wall_damping_ratio`` (default railslosh.vehicle.WALL_DAMPING_RATIO = 0.1) goes to
+    run_fluid, is recorded, changes the wall's damping, is refused out of [0, 10], and does not go
+    to the equivalent model (it has no walls)."""
+    assert railslosh.vehicle.WALL_DAMPING_RATIO == pytest.approx(0.1)
+    base = _set_dotted(FLUID_BASE, "train.t_end", 0.3)
+    assert scene.load_scene(base).fluid_kwargs()["wall_damping_ratio"] == railslosh.vehicle.WALL_DAMPING_RATIO
+    doc = _set_dotted(base, "tank", {"wall_damping_ratio": 1.0})
+    sc = scene.load_scene(doc)
+    assert sc.fluid.wall_damping_ratio == 1.0 and sc.fluid_kwargs()["wall_damping_ratio"] == 1.0
+    assert "wall_damping_ratio" not in sc.equivalent_kwargs("longitudinal")
+    assert scene.load_scene(sc.to_dict()).fluid == sc.fluid
+    with pytest.raises(ValueError, match=r"invalid parameter `tank.wall_damping_ratio` = 11"):
+        scene.load_scene(_set_dotted(base, "tank", {"wall_damping_ratio": 11.0}))
+    rows = sc.track_rows
+    light = railslosh.vehicle.run_fluid(rows, **scene.load_scene(base).fluid_kwargs())
+    damped = railslosh.vehicle.run_fluid(rows, **sc.fluid_kwargs())
+    assert damped["wall_damping_ratio"] == 1.0
+    assert results.to_dataset(damped).attrs["wall_damping_ratio"] == 1.0
+    # the liquid falls onto the walls as the run starts: more wall damping, another wall load
+    f0, f1 = np.asarray(light["fluid_force_tank"]), np.asarray(damped["fluid_force_tank"])
+    assert np.abs(f1 - f0).max() > 1e-3 * np.abs(f0).max()

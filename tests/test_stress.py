@@ -266,3 +266,11 @@ slosh.run(mesh.box({BOX!r}, (2, 3, 2)), fluids.water(depth=0.132), tank, motion,
         t_end=float(got["t"][-1]),
     )
     _arrays_equal(got, ref, slice(0, n - 1))
+
+
+def test_the_matrix_builds_the_herschel_bulkley_fluid_its_case_names():
+    """The yield-stress, power-index and rheology cases vary the law they name (an earlier
+    positional call passed tau0 as the consistency and mu as the power index)."""
+    f = stress._fluid({"penalty_factor": 1.0, "viscosity": 0.1, "yield_stress": 1000.0, "power_index": 0.5}, 0.1)
+    assert f.model == "herschel-bulkley" and f.yield_stress == 1000.0
+    assert "consistency: 0.1," in repr(f) and "power_index: 0.5," in repr(f)

@@ -12,6 +12,8 @@ __version__: str
 _Progress = Callable[[float, float, int, int, int], object]
 """Progress callback of the runs: ``(t, t_end, steps, newton_iterations, rejected_steps)``."""
 
+WALL_DAMPING_RATIO: float
+
 class RailsloshError(Exception):
     """Base class of railslosh simulation errors."""
 
@@ -161,6 +163,7 @@ def run_slosh(
     contact_points_per_edge: int = 3,
     contact_point_rule: str = "gauss",
     stepper: str = "implicit",
+    wall_damping_ratio: float = 0.1,
 ) -> dict[str, Any]: ...
 def run_validation(name: str, quick: bool = False) -> list[dict[str, Any]]: ...
 def work_precision_cases() -> list[str]: ...
@@ -331,6 +334,7 @@ def run_fluid_train(
     car: dict[str, float] | None = None,
     progress: _Progress | None = None,
     stream: str | None = None,
+    wall_damping_ratio: float = 0.1,
 ) -> dict[str, Any]: ...
 def run_equivalent_train(
     track: list[list[float]],

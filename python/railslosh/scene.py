@@ -50,7 +50,9 @@ Oldroyd model); ``fill`` (liquid volume as a fraction of the tank volume, 0.1 to
 ``elastic_modulus`` (Pa), ``bulk_penalty`` (Pa, default 1000 rho g depth) and ``bulk_damping``.
 ``[mesh]``: ``counts = [n_length, n_width, n_height]`` fluid elements (1-40, 2-20, 1-10).
 ``[tank]``: ``bulkheads = [[x, thickness], ...]`` in the tank frame (m; full-height plates; each
-compartment needs at least one element along the length).
+compartment needs at least one element along the length); ``wall_damping_ratio`` (0 to 10, default
+0.1): damping ratio of the liquid column on the penalty wall; 1 removes most of the wall ringing
+from the loads after a wave hits a head (docs/validation.md, "Wall damping").
 ``[outputs]``: ``snapshot_every`` (s, fluid mesh snapshots for ParaView; 0 = none), ``netcdf``,
 ``vtu``, ``plots`` (booleans, what ``railslosh run`` writes). Rigid lading, coupler overrides and
 wheelset offsets are not available with liquid cargo.
@@ -259,6 +261,9 @@ class FluidSpec:
     """Constructor arguments of :class:`railslosh.Fluid` when ``oil = "custom"``."""
     slosh_model: str = "auto"
     """``[fluid] slosh_model``: ``"auto"``, ``"ancf"``, ``"pendulum"`` or ``"rigid"``."""
+    wall_damping_ratio: float = vehicle.WALL_DAMPING_RATIO
+    """``[tank] wall_damping_ratio``: damping ratio of the liquid column on the penalty wall (0 to 10;
+    1 removes most wall ringing from the loads: :func:`railslosh.vehicle.run_fluid`)."""
 
     def make_fluid(self, depth: float, element_height: float | None = None) -> Any:
         """The :class:`railslosh.Fluid` for a liquid ``depth`` m deep: penalty ``k = 1000 rho g depth``
@@ -318,6 +323,8 @@ class FluidSpec:
         d: dict[str, Any] = {"fluid": fl, "mesh": {"counts": list(self.counts)}}
         if self.bulkheads:
             d["tank"] = {"bulkheads": [list(b) for b in self.bulkheads]}
+        if self.wall_damping_ratio != vehicle.WALL_DAMPING_RATIO:
+            d.setdefault("tank", {})["wall_damping_ratio"] = self.wall_damping_ratio
         return d
 
 
@@ -410,6 +417,7 @@ class Scene:
             "bulkheads": [tuple(b) for b in f.bulkheads] or None,
             "snapshot_every": self.outputs.snapshot_every,
             "brake_factors": None if self.brake_factors is None else list(self.brake_factors),
+            "wall_damping_ratio": f.wall_damping_ratio,
         }
         return kw
 
@@ -417,7 +425,7 @@ class Scene:
         """Keyword arguments of :func:`railslosh.vehicle.run_equivalent` (after the track): the liquid
         as its equivalent slosh model along ``slosh_axis``."""
         kw = self.fluid_kwargs()
-        for k in ("counts", "snapshot_every"):
+        for k in ("counts", "snapshot_every", "wall_damping_ratio"):
             kw.pop(k)
         kw["slosh_axis"] = slosh_axis
         return kw
@@ -793,10 +801,19 @@ def _fluid_spec(data: Mapping[str, Any], params: Mapping[str, float]) -> FluidSp
     _check_keys(ms, "mesh", ("counts",))
     counts = _counts(ms.get("counts", [6, 4, 2]), "mesh.counts", ((1, 40), (2, 20), (1, 10)))
     tk = _table(data.get("tank", {}), "tank")
-    _check_keys(tk, "tank", ("bulkheads",))
+    _check_keys(tk, "tank", ("bulkheads", "wall_damping_ratio"))
     half = 0.5 * (params["tank_length"] - 1.0)
     bulkheads = _bulkheads(tk.get("bulkheads", []), "tank.bulkheads", half, counts[0])
-    spec = FluidSpec(oil=oil, fill=fill, counts=counts, bulkheads=bulkheads, custom=custom, slosh_model=slosh_model)
+    zeta = _number(tk.get("wall_damping_ratio", vehicle.WALL_DAMPING_RATIO), "tank.wall_damping_ratio", 0.0, 10.0, "")
+    spec = FluidSpec(
+        oil=oil,
+        fill=fill,
+        counts=counts,
+        bulkheads=bulkheads,
+        custom=custom,
+        slosh_model=slosh_model,
+        wall_damping_ratio=zeta,
+    )
     if oil == "custom":
         spec.make_fluid(2.0 * params["tank_radius"] * fill)  # validates the custom fluid now
     return spec
@@ -848,7 +865,8 @@ class SloshScene:
     ``[tank]``: ``shape = "elliptic"`` (flat-ended cylinder of elliptical section; ``length``,
     ``semi_axis_y``, ``semi_axis_z``; defaults: the SwRI tank of seed 003), ``"cylinder"`` (``length``
     of the shell, ``radius``, ``head_depth``; defaults: the crude-oil tank car) or ``"box"`` (``lower``,
-    ``upper`` corners); ``bulkheads`` as in vehicle scenes (cylinder only).
+    ``upper`` corners); ``bulkheads`` as in vehicle scenes (cylinder only); ``wall_damping_ratio`` as in
+    vehicle scenes (damping ratio of the liquid column on the penalty wall, 0 to 10, default 0.1).
     ``[fluid]``: as in vehicle scenes (``oil``, ``fill`` as a volume fraction, custom
     fluids). ``[mesh]``: ``counts``; ``viscous_points`` and ``penalty_points`` (Gauss points per
     direction of the viscous stress, 3-6, and of the volumetric penalty, 2-6; default 3) and
@@ -978,6 +996,8 @@ class SloshScene:
         }
         if self.contact_stiffness_factor != 1.0:
             kw["contact_stiffness_factor"] = self.contact_stiffness_factor
+        if self.fluid.wall_damping_ratio != vehicle.WALL_DAMPING_RATIO:
+            kw["wall_damping_ratio"] = self.fluid.wall_damping_ratio
         return (self.mesh(), fluid, self.tank, self.motion()), kw
 
     def to_dict(self) -> dict[str, Any]:
@@ -1185,8 +1205,12 @@ def slosh_scene_from_dict(data: Mapping[str, Any]) -> SloshScene:
         k: _integer(ms.get(k, 3), f"mesh.{k}", lo, 6)
         for k, lo in (("viscous_points", 3), ("penalty_points", 2), ("contact_points_per_edge", 2))
     }
-    tank = _slosh_tank(_table(data.get("tank", {}), "tank"), counts)
-    spec = FluidSpec(oil=oil, fill=fill, counts=counts, bulkheads=tank.bulkheads, custom=custom)
+    tk = dict(_table(data.get("tank", {}), "tank"))
+    zeta = _number(tk.pop("wall_damping_ratio", vehicle.WALL_DAMPING_RATIO), "tank.wall_damping_ratio", 0.0, 10.0, "")
+    tank = _slosh_tank(tk, counts)
+    spec = FluidSpec(
+        oil=oil, fill=fill, counts=counts, bulkheads=tank.bulkheads, custom=custom, wall_damping_ratio=zeta
+    )
     maneuver = _maneuver(_table(data.get("maneuver", {}), "maneuver"), t_end)
     out = _table(data.get("outputs", {}), "outputs")
     if out.get("vtu", False) is not False or "snapshot_every" in out:

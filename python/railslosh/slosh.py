@@ -123,6 +123,7 @@ def run(
     penalty_points: int = 3,
     contact_points_per_edge: int = 3,
     stepper: str = "implicit",
+    wall_damping_ratio: float = _core.WALL_DAMPING_RATIO,
 ) -> dict:
     """Integrate the fluid in the moving tank up to `t_end` with steps of at most `h`.
 
@@ -138,7 +139,10 @@ def run(
     :class:`SimulationError` (``cause`` ``"volume_error"`` / ``"contact_penetration"``) when the
     fluid volume deviates from its initial value by more than ``volume_tolerance`` (relative), or
     a boundary point penetrates a wall deeper than ``penetration_limit`` times the smallest element
-    edge (``math.inf`` disables either). ``contact_stiffness_factor`` scales the wall-contact
+    edge (``math.inf`` disables either). ``wall_damping_ratio`` (0 to 10, default
+    ``_core.WALL_DAMPING_RATIO`` = 0.1) is the damping ratio of the liquid column on the penalty
+    wall spring; 1 (critical) removes most of the wall ringing from the loads after an impact
+    (docs/validation.md, "Wall damping"). ``contact_stiffness_factor`` scales the wall-contact
     penalty stiffness (damping ratio kept).
 
     Run-time invariants (``rail_mbs::invariants``), also on every accepted step: ``"containment"``
@@ -201,7 +205,9 @@ def run(
         penalty_points=penalty_points,
         contact_points_per_edge=contact_points_per_edge,
         stepper=stepper,
+        wall_damping_ratio=wall_damping_ratio,
     )
+    res["wall_damping_ratio"] = wall_damping_ratio
     if res["error"] is not None:
         raise SimulationError(f"slosh run stopped at t = {res['t'][-1]:.4f} s: {res['error']}", res)
     return res

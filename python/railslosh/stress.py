@@ -230,7 +230,10 @@ def _fluid(kw: dict[str, Any], depth: float):
     k = kw["penalty_factor"] * fluids.default_bulk_penalty(rho, depth)
     mu, tau, n = kw["viscosity"], kw["yield_stress"], kw["power_index"]
     if n != 1.0 or tau > 0.0:
-        return fluids.herschel_bulkley(rho, tau, mu, n, depth=depth, bulk_penalty=k)
+        # by keyword: the positional order is (density, consistency, power_index, yield_stress)
+        return fluids.herschel_bulkley(
+            rho, consistency=mu, power_index=n, yield_stress=tau, depth=depth, bulk_penalty=k
+        )
     return fluids.newtonian(rho, mu, depth=depth, bulk_penalty=k)
 
 

@@ -25,6 +25,10 @@ import numpy as np
 from railslosh import _core
 from railslosh.slosh import SimulationError
 
+WALL_DAMPING_RATIO: float = _core.WALL_DAMPING_RATIO
+"""Default damping ratio of the liquid column on the penalty wall of a fluid vehicle run
+(``rail_mbs``/``ancf_core::contact::WALL_DAMPING_RATIO``; ``wall_damping_ratio`` of :func:`run_fluid`)."""
+
 __all__ = [
     "design_brake_torque",
     "equivalent_model",
@@ -182,6 +186,7 @@ def run_fluid(
     car: dict[str, float] | None = None,
     progress: Callable[[float, float, int, int, int], object] | None = None,
     stream: str | os.PathLike[str] | None = None,
+    wall_damping_ratio: float = WALL_DAMPING_RATIO,
 ) -> dict[str, Any]:
     """Run tank cars whose tanks carry an ANCF fluid, solved monolithically with the cars.
 
@@ -191,7 +196,10 @@ def run_fluid(
     in the tank frame (m). Returns the arrays of :func:`run` plus ``oil_com_tank`` and ``oil_com_global``
     (samples, cars, 3), ``fluid_force_tank`` (the fluid's load on each tank, tank frame), ``volume_error``
     and ``snapshots`` (``[(t, [nodes x 4 x 3 per car])]``, position then gradients per node).
-    ``progress`` and ``stream`` work as in :func:`run`.
+    ``progress`` and ``stream`` work as in :func:`run`. ``wall_damping_ratio`` (0 to 10, default
+    :data:`WALL_DAMPING_RATIO`) is the damping ratio of the liquid column on the penalty wall
+    spring: 1 (critical) removes most of the 20-30 Hz wall ringing from the loads after a wave
+    hits a head, at about 1.35x the run time (docs/validation.md, "Wall damping").
     """
     drive_speed, times, torques = _drive_and_brake(drive, speed, brake)
     res = dict(
@@ -219,9 +227,11 @@ def run_fluid(
             car=car,
             progress=progress,
             stream=None if stream is None else os.fspath(stream),
+            wall_damping_ratio=wall_damping_ratio,
         )
     )
     res["load_filter"] = load_filter
+    res["wall_damping_ratio"] = wall_damping_ratio
     return _raise_on_error(res, "fluid vehicle run")
 
 

@@ -111,25 +111,51 @@ pub struct WallContactLaw {
     pub point_rule: ContactPointRule,
 }
 
+/// Default damping ratio ζ_w of the liquid column on the penalty wall spring
+/// ([`WallContactLaw::default_for`]). The column-on-spring mode, (1/2π)√(k_p/(ρ L)) = 20–30 Hz
+/// in the tanks here, is an artefact of the penalty wall (a liquid does not rebound from a
+/// wall), and at ζ_w = 0.1 it rings in the loads after an impact; ζ_w = 1 (critical) removes
+/// most of that ringing at a higher cost per simulated second (docs/validation.md, "Wall
+/// damping"). Runs choose it with [`WallContactLaw::with_damping_ratio`] (`wall_damping_ratio`
+/// of scenes and the Python API).
+pub const WALL_DAMPING_RATIO: f64 = 0.1;
+
 impl WallContactLaw {
     /// Defaults derived from the fluid and the liquid depth H (see `docs/architecture.md`):
     /// - k_p = 1000 ρ g: the hydrostatic pressure at the bottom, ρ g H, is carried with a
     ///   penetration δ_e = 10⁻³ H;
     /// - c_p such that the liquid column bouncing on the wall (mass ρH per unit area on the
-    ///   spring k_p) is damped (ζ = 0.1) at the equilibrium penetration:
-    ///   c_p δ_e = 2 ζ √(k_p ρ H), ζ = 0.1;
+    ///   spring k_p) has the damping ratio [`WALL_DAMPING_RATIO`] at the equilibrium
+    ///   penetration: c_p δ_e = 2 ζ_w √(k_p ρ H);
     /// - frictionless walls; 3×3 points per face.
     pub fn default_for(density: f64, gravity: f64, depth: f64) -> Self {
         let k = 1000.0 * density * gravity;
-        let delta_e = density * gravity * depth / k;
-        let c = 2.0 * 0.1 * (k * density * depth).sqrt() / delta_e;
-        Self {
+        let mut law = Self {
             stiffness: k,
-            damping: c,
+            damping: 0.0,
             friction: WallFriction::Frictionless,
             points_per_edge: 3,
             point_rule: ContactPointRule::Gauss,
+        };
+        law.damping = law.damping_for_ratio(WALL_DAMPING_RATIO, density, gravity, depth);
+        law
+    }
+
+    /// c_p that gives the liquid column of depth `depth` on this law's wall spring the damping
+    /// ratio `zeta` at the equilibrium penetration δ_e = ρ g H / k_p: c_p = 2 ζ √(k_p ρ H)/δ_e.
+    pub fn damping_for_ratio(&self, zeta: f64, density: f64, gravity: f64, depth: f64) -> f64 {
+        let delta_e = density * gravity * depth / self.stiffness;
+        2.0 * zeta * (self.stiffness * density * depth).sqrt() / delta_e
+    }
+
+    /// This law with the wall damping ratio `zeta` (finite, in [0, 10]) for a liquid of
+    /// `density` and `depth` under `gravity` ([`Self::damping_for_ratio`]).
+    pub fn with_damping_ratio(mut self, zeta: f64, density: f64, gravity: f64, depth: f64) -> Result<Self> {
+        if !(zeta.is_finite() && (0.0..=10.0).contains(&zeta)) {
+            return Err(invalid("wall_damping_ratio", zeta, "a number in [0, 10]"));
         }
+        self.damping = self.damping_for_ratio(zeta, density, gravity, depth);
+        Ok(self)
     }
 
     /// Validate; errors name the field.
@@ -904,6 +930,43 @@ mod tests {
     use crate::tank::{Bulkhead, TankShape};
     use crate::validate::Rng;
     use nalgebra::Rotation3;
+
+    /// The liquid column of depth H (mass ρH per unit area) resting on the wall spring,
+    /// m ψ̈ = m g − k_p ψ − c_p |ψ| ψ̇, nudged from its equilibrium ψ = δ_e: the logarithmic
+    /// decrement of its free oscillation gives back the damping ratio the law was built with.
+    #[test]
+    fn the_wall_damping_ratio_is_the_damping_ratio_of_the_liquid_column_on_the_wall() {
+        let (rho, g, depth) = (998.0, 9.81, 0.132);
+        let m = rho * depth;
+        let law0 = WallContactLaw::default_for(rho, g, depth);
+        for zeta in [WALL_DAMPING_RATIO, 0.3] {
+            let law = law0.with_damping_ratio(zeta, rho, g, depth).unwrap();
+            let (k, c) = (law.stiffness, law.damping);
+            let delta_e = m * g / k;
+            let rhs = |psi: f64, v: f64| g - (k * psi + c * psi.abs() * v) / m;
+            let (mut psi, mut v, h) = (1.001 * delta_e, 0.0, 1e-6);
+            let mut peaks = Vec::new();
+            let mut last_v: f64 = 0.0;
+            for _ in 0..200_000 {
+                let k1 = (v, rhs(psi, v));
+                let k2 = (v + 0.5 * h * k1.1, rhs(psi + 0.5 * h * k1.0, v + 0.5 * h * k1.1));
+                let k3 = (v + 0.5 * h * k2.1, rhs(psi + 0.5 * h * k2.0, v + 0.5 * h * k2.1));
+                let k4 = (v + h * k3.1, rhs(psi + h * k3.0, v + h * k3.1));
+                psi += h / 6.0 * (k1.0 + 2.0 * k2.0 + 2.0 * k3.0 + k4.0);
+                v += h / 6.0 * (k1.1 + 2.0 * k2.1 + 2.0 * k3.1 + k4.1);
+                if last_v > 0.0 && v <= 0.0 {
+                    peaks.push(psi - delta_e);
+                }
+                last_v = v;
+            }
+            let d = (peaks[0] / peaks[1]).ln();
+            let measured = d / (4.0 * std::f64::consts::PI * std::f64::consts::PI + d * d).sqrt();
+            assert!((measured - zeta).abs() < 0.01 * zeta, "ζ_w = {zeta}: measured {measured}");
+        }
+        assert_eq!(law0.damping, law0.with_damping_ratio(WALL_DAMPING_RATIO, rho, g, depth).unwrap().damping);
+        let e = law0.with_damping_ratio(-0.1, rho, g, depth).unwrap_err().to_string();
+        assert!(e.contains("wall_damping_ratio") && e.contains("[0, 10]"), "{e}");
+    }
 
     fn setup(friction: WallFriction) -> (FluidBody, WallContact, TankKinematics, Vec<f64>, Vec<f64>) {
         let mesh = box_mesh([-0.3, -0.2, 0.0], [0.6, 0.4, 0.3], [2, 2, 1]).unwrap();

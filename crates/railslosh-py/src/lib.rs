@@ -444,7 +444,8 @@ impl PyFluidBody {
                     t_end, h, frame="inertial", gravity=[0.0, 0.0, -9.81], viscous_points=3, penalty_points=3,
                     progress=None, volume_tolerance=0.01, penetration_limit=0.5, contact_stiffness_factor=1.0,
                     stream=None, checkpoint=None, checkpoint_every=100, resume_from=None,
-                    contact_points_per_edge=3, contact_point_rule="gauss", stepper="implicit"))]
+                    contact_points_per_edge=3, contact_point_rule="gauss", stepper="implicit",
+                    wall_damping_ratio=ancf_core::contact::WALL_DAMPING_RATIO))]
 #[allow(clippy::too_many_arguments)]
 fn run_slosh<'py>(
     py: Python<'py>,
@@ -473,6 +474,7 @@ fn run_slosh<'py>(
     contact_points_per_edge: usize,
     contact_point_rule: &str,
     stepper: &str,
+    wall_damping_ratio: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
     use ancf_core::contact::{ContactPointRule, WallContact, WallContactLaw};
     use ancf_core::tank::{Bulkhead, TankGeometry, TankShape};
@@ -537,8 +539,13 @@ fn run_slosh<'py>(
         let depth =
             (body.mesh.free_surface_z - body.mesh.nodes.iter().map(|n| n[2]).fold(f64::INFINITY, f64::min)).max(1e-3);
         let g = (gravity[0].powi(2) + gravity[1].powi(2) + gravity[2].powi(2)).sqrt().max(1e-3);
-        let mut law = WallContactLaw::default_for(f.density, g, depth);
-        // k × s with the damping ratio of the default law kept (c ∝ k^1.5 there)
+        let mut law = WallContactLaw::default_for(f.density, g, depth).with_damping_ratio(
+            wall_damping_ratio,
+            f.density,
+            g,
+            depth,
+        )?;
+        // k × s with the damping ratio kept (c ∝ k^1.5 there)
         law.stiffness *= contact_stiffness_factor;
         law.damping *= contact_stiffness_factor.powf(1.5);
         law.points_per_edge = contact_points_per_edge;
@@ -720,6 +727,7 @@ fn _panic_for_test(py: Python<'_>) -> PyResult<()> {
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("RailsloshError", m.py().get_type::<RailsloshError>())?;
+    m.add("WALL_DAMPING_RATIO", ancf_core::contact::WALL_DAMPING_RATIO)?;
     m.add_class::<PyFluidMesh>()?;
     m.add_class::<PyFluid>()?;
     m.add_class::<PyFluidBody>()?;

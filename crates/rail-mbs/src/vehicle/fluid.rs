@@ -573,6 +573,10 @@ pub struct FluidCargo {
     pub wall_stiffness_factor: f64,
     /// Contact points per edge of each boundary face.
     pub contact_points_per_edge: usize,
+    /// Damping ratio of the liquid column on the wall spring
+    /// ([`ancf_core::contact::WallContactLaw::with_damping_ratio`]); default
+    /// [`ancf_core::contact::WALL_DAMPING_RATIO`].
+    pub wall_damping_ratio: f64,
 }
 
 impl FluidCargo {
@@ -591,6 +595,7 @@ impl FluidCargo {
             quadrature: QuadratureOptions { penalty: 4, ..QuadratureOptions::default() },
             wall_stiffness_factor: 1.0,
             contact_points_per_edge: 4,
+            wall_damping_ratio: ancf_core::contact::WALL_DAMPING_RATIO,
         }
     }
 }
@@ -709,7 +714,12 @@ pub fn build_fluid_train(
     )?;
     let g = crate::track::GRAVITY;
     let depth = 2.0 * p.tank_radius * cargo.fill;
-    let mut law = WallContactLaw::default_for(cargo.fluid.density, g, depth);
+    let mut law = WallContactLaw::default_for(cargo.fluid.density, g, depth).with_damping_ratio(
+        cargo.wall_damping_ratio,
+        cargo.fluid.density,
+        g,
+        depth,
+    )?;
     ancf_core::error::check_positive("wall_stiffness_factor", cargo.wall_stiffness_factor)?;
     law.stiffness *= cargo.wall_stiffness_factor;
     law.damping *= cargo.wall_stiffness_factor.powf(1.5);
