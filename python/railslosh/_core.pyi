@@ -163,7 +163,7 @@ def run_slosh(
     contact_points_per_edge: int = 3,
     contact_point_rule: str = "gauss",
     stepper: str = "implicit",
-    wall_damping_ratio: float = 0.1,
+    wall_damping_ratio: float = ...,
 ) -> dict[str, Any]: ...
 def run_validation(name: str, quick: bool = False) -> list[dict[str, Any]]: ...
 def work_precision_cases() -> list[str]: ...
@@ -334,7 +334,7 @@ def run_fluid_train(
     car: dict[str, float] | None = None,
     progress: _Progress | None = None,
     stream: str | None = None,
-    wall_damping_ratio: float = 0.1,
+    wall_damping_ratio: float = ...,
 ) -> dict[str, Any]: ...
 def run_equivalent_train(
     track: list[list[float]],
