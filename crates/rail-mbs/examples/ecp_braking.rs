@@ -1,5 +1,5 @@
 //! One braking run of the crude-oil studies with its wall time and Newton statistics:
-//! `cargo run --release -p rail-mbs --example ecp_braking -- [light|medium|heavy|water] [nx ny nz] [t_end] [ecp|conventional] [bulkheads]`
+//! `cargo run --release -p rail-mbs --example ecp_braking -- [light|medium|heavy|water] [nx ny nz] [t_end] [ecp|conventional] [bulkheads|-] [wall_damping_ratio]`
 use rail_mbs::vehicle::BrakeScope;
 use rail_mbs::vehicle::studies::{BrakingCase, Oil, SETTLE, run_braking};
 
@@ -12,7 +12,9 @@ fn main() {
     let scope =
         if a.get(5).map(|s| s.as_str()) == Some("conventional") { BrakeScope::FrontCar } else { BrakeScope::AllCars };
     let bulkheads = a.get(6).map(|s| s.as_str()) == Some("bulkheads");
-    let case = BrakingCase { oil, cars: 2, scope, bulkheads, counts, t_end, rear_brake_factor: 1.0 };
+    let wall_damping_ratio = a.get(7).map_or(ancf_core::contact::WALL_DAMPING_RATIO, |s| s.parse().unwrap());
+    let case =
+        BrakingCase { oil, cars: 2, scope, bulkheads, counts, t_end, rear_brake_factor: 1.0, wall_damping_ratio };
     let r = run_braking(&case).expect("run");
     let s = &r.train;
     let peak = s.coupler_force.iter().map(|c| c[0].abs()).fold(0.0, f64::max);

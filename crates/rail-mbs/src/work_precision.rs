@@ -282,6 +282,7 @@ fn ecp_braking(
             counts: s.counts,
             t_end,
             rear_brake_factor,
+            wall_damping_ratio: ancf_core::contact::WALL_DAMPING_RATIO,
         };
         let tic = Instant::now();
         let out = run_braking_with(&case, s.step, s.rel_tol);

@@ -118,6 +118,10 @@ pub struct BrakingCase {
     pub t_end: f64,
     /// Rear-car brake factor (1 = identical brakes, the paper's ECP).
     pub rear_brake_factor: f64,
+    /// Damping ratio of the liquid column on the tank walls ([`FluidCargo::wall_damping_ratio`];
+    /// the library default [`ancf_core::contact::WALL_DAMPING_RATIO`], or 1 as the shipped ECP
+    /// scenes use).
+    pub wall_damping_ratio: f64,
 }
 
 /// Settling time before the brakes apply, s.
@@ -169,7 +173,8 @@ pub fn run_braking(case: &BrakingCase) -> Result<FluidTrainRecord> {
 /// tolerance `rel_tol` (the work–precision sweeps vary them).
 pub fn run_braking_with(case: &BrakingCase, step: f64, rel_tol: f64) -> Result<FluidTrainRecord> {
     let p = TankCarParams::standard()?;
-    let cg = cargo(case.oil, case.counts, case.bulkheads, &p)?;
+    let mut cg = cargo(case.oil, case.counts, case.bulkheads, &p)?;
+    cg.wall_damping_ratio = case.wall_damping_ratio;
     let v0 = 40.0 / 3.6;
     let mut sc = TrainScenario::single(p.clone(), tangent()?, 300.0, v0, case.t_end);
     sc.cars = case.cars;
@@ -269,7 +274,16 @@ fn oscillation(x: &[(f64, f64)], t0: f64, t1: f64) -> f64 {
 
 fn braking(oil: Oil, cars: usize, scope: BrakeScope, bulkheads: bool, quick: bool, rear: f64) -> BrakingCase {
     let (counts, t_end) = braking_setup(quick);
-    BrakingCase { oil, cars, scope, bulkheads, counts, t_end, rear_brake_factor: rear }
+    BrakingCase {
+        oil,
+        cars,
+        scope,
+        bulkheads,
+        counts,
+        t_end,
+        rear_brake_factor: rear,
+        wall_damping_ratio: ancf_core::contact::WALL_DAMPING_RATIO,
+    }
 }
 
 fn ecp_braking_oils(quick: bool) -> Result<Vec<Record>> {
@@ -569,6 +583,7 @@ fn mesh_convergence(quick: bool) -> Result<Vec<Record>> {
                     counts: m,
                     t_end,
                     rear_brake_factor: 1.0,
+                    wall_damping_ratio: ancf_core::contact::WALL_DAMPING_RATIO,
                 })
             }) as Job<'static, FluidTrainRecord>
         })
@@ -623,7 +638,8 @@ fn coupler_statistics(rec: &FluidTrainRecord) -> [f64; 3] {
 /// are taken against the finer run's value; for the ECP steady mean, whose reference is
 /// near zero (identical brakes), against the conventional steady mean (the scale of the
 /// coupler force in this study). Quick: meshes 2×2×2, 3×2×2, 4×2×2, 3 s; full: 4×4×2,
-/// 6×4×2 (the paper's), 8×4×2, the paper's 10.5 s.
+/// 6×4×2 (the paper's), 8×4×2, the paper's 10.5 s. Walls critically damped
+/// (`wall_damping_ratio` = 1, as the shipped ECP scenes: docs/validation.md "Wall damping").
 fn coupler_force_convergence(quick: bool) -> Result<Vec<Record>> {
     let c = "coupler-force-convergence";
     let (meshes, t_end): ([[usize; 3]; 3], f64) =
@@ -638,6 +654,7 @@ fn coupler_force_convergence(quick: bool) -> Result<Vec<Record>> {
             counts,
             t_end,
             rear_brake_factor: 1.0,
+            wall_damping_ratio: 1.0,
         };
         for m in meshes {
             jobs.push(Box::new(move || run_braking(&case(m))));
