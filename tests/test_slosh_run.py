@@ -118,3 +118,23 @@ def test_critical_wall_damping_takes_the_wall_ringing_out_of_the_load():
     assert f1[1.0] == pytest.approx(f1[0.1], abs=0.5), f1  # within the 0.43 Hz bins of the window
     with pytest.raises(ValueError, match="wall_damping_ratio"):
         rs.slosh.run(m, water, tank, motion, t_end=0.01, wall_damping_ratio=-1.0)
+
+
+def test_the_explicit_stepper_stays_stable_with_critically_damped_walls():
+    """The explicit stable step also bounds the most damped mode (2/(omega_max + mu_max), mu_max the
+    largest eigenvalue of M^-1 C): with wall_damping_ratio = 1 the wall-contact points' Hunt-Crossley
+    damping made the earlier estimate, which only saw the damping of the stiffest mode, unstable
+    (energy_growth at 0.04 s). Measured: centre of mass within 0.11 % of its range of the implicit
+    run, lateral load RMS within 0.7 %."""
+    mesh, tank, water = small_tank()
+    motion = rs.slosh.Motion().pulse("y", 2.0, 0.05, 0.35, ramp=0.05)
+    kw = dict(t_end=0.6, h=0.01, viscous_points=4, penalty_points=4, wall_damping_ratio=1.0)
+    imp = rs.slosh.run(mesh, water, tank, motion, **kw)
+    exp = rs.slosh.run(mesh, water, tank, motion, **kw, stepper="explicit")
+    assert exp["t"][-1] == pytest.approx(0.6) and exp["margins"]["worst_energy_error"] <= 0.01
+    ci = np.asarray(imp["com_tank"])[:, 1]
+    ce = np.interp(imp["t"], exp["t"], np.asarray(exp["com_tank"])[:, 1])
+    assert np.abs(ci - ce).max() <= 0.02 * np.ptp(ci)
+    fi = np.asarray(imp["force_tank"])[:, 1]
+    fe = np.interp(imp["t"], exp["t"], np.asarray(exp["force_tank"])[:, 1])
+    assert np.sqrt((fe**2).mean()) == pytest.approx(np.sqrt((fi**2).mean()), rel=0.02)

@@ -23,6 +23,12 @@
 //! h ≤ (2/ω_max)(√(1+ξ²) − ξ). [`Explicit::estimate_stable_step`] finds ω²_max by power
 //! iteration on M⁻¹K, with K·x and C·x (C = −∂Q/∂v) by directional differences of Q (so
 //! every force, including wall contact, counts), warm-started from the last eigenvector.
+//! The most damped mode need not be the stiffest one (a wall-contact point's gradient
+//! coordinates under Hunt–Crossley damping c|ψ|ψ̇ are), so a second power iteration finds
+//! μ_max, the largest eigenvalue of M⁻¹C, and the estimate is also bounded by
+//! 2/(ω_max + μ_max): for a mode with ω ≤ ω_max and 2ξω = μ ≤ μ_max,
+//! (2/ω)(√(1+ξ²) − ξ) = 2/(ω(√(1+ξ²) + ξ)) ≥ 2/(ω + μ) ≥ 2/(ω_max + μ_max) (exact for
+//! modally damped systems, a heuristic otherwise).
 //! The step used is `safety` × the estimate, re-estimated every `estimate_every` steps.
 
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -144,7 +150,10 @@ pub struct StableStep {
     pub omega_max: f64,
     /// Modal damping ratio at ω_max.
     pub damping_ratio: f64,
-    /// Critical step (2/ω)(√(1+ξ²) − ξ), s.
+    /// Largest eigenvalue μ_max of M⁻¹C (1/s): twice the damping rate ξω of the most damped
+    /// mode.
+    pub damping_max: f64,
+    /// Critical step: the smaller of (2/ω)(√(1+ξ²) − ξ) and 2/(ω_max + μ_max), s.
     pub critical: f64,
 }
 
@@ -159,6 +168,7 @@ pub struct Explicit<S: MechanicalSystem> {
     a: Vec<f64>,
     force: Vec<f64>,
     eigenvector: Vec<f64>,
+    damped_vector: Vec<f64>,
     stable: Option<StableStep>,
     since_estimate: usize,
     stats: Stats,
@@ -209,7 +219,8 @@ impl<S: MechanicalSystem> Explicit<S> {
         let mut a = vec![0.0; n];
         mass.solve(&force, &mut a);
         // a smooth, deterministic start vector for the power iteration
-        let eigenvector = (0..n).map(|i| (i as f64 * 0.618_033_988_75).fract() - 0.5).collect();
+        let eigenvector: Vec<f64> = (0..n).map(|i| (i as f64 * 0.618_033_988_75).fract() - 0.5).collect();
+        let damped_vector = eigenvector.clone();
         let stats = Stats { residual_evaluations: 1, linear_solves: 1, ..Default::default() };
         Ok(Self {
             system,
@@ -221,6 +232,7 @@ impl<S: MechanicalSystem> Explicit<S> {
             a,
             force,
             eigenvector,
+            damped_vector,
             stable: None,
             since_estimate: 0,
             stats,
@@ -332,8 +344,31 @@ impl<S: MechanicalSystem> Explicit<S> {
                 what: format!("stable-step estimate at t = {t} s: no positive stiffness found (ω² = {lambda})"),
             });
         }
-        let critical = 2.0 / omega * ((1.0 + xi * xi).sqrt() - xi);
-        let s = StableStep { omega_max: omega, damping_ratio: xi, critical };
+        // μ_max: power iteration on M⁻¹C, C x by directional differences in v
+        let mut x = std::mem::take(&mut self.damped_vector);
+        let vmag = v.iter().fold(0.0_f64, |m, a| m.max(a.abs())).max(1.0);
+        let mut mu = 0.0;
+        for _ in 0..iterations {
+            let nx = norm(&x);
+            if nx.is_nan() || nx <= 0.0 {
+                break;
+            }
+            x.iter_mut().for_each(|a| *a /= nx);
+            let eps = 1e-7 * vmag;
+            let vp: Vec<f64> = v.iter().zip(&x).map(|(a, b)| a + eps * b).collect();
+            self.eval(t, &q, &vp, &mut fp)?;
+            for i in 0..n {
+                fp[i] = -(fp[i] - f0[i]) / eps; // C x
+            }
+            self.mass.solve(&fp, &mut y);
+            self.stats.linear_solves += 1;
+            mu = x.iter().zip(&y).map(|(a, b)| a * b).sum::<f64>().abs().max(norm(&y));
+            std::mem::swap(&mut x, &mut y);
+        }
+        self.damped_vector = x;
+        let mu = if mu.is_finite() { mu } else { 0.0 };
+        let critical = (2.0 / omega * ((1.0 + xi * xi).sqrt() - xi)).min(2.0 / (omega + mu));
+        let s = StableStep { omega_max: omega, damping_ratio: xi, damping_max: mu, critical };
         self.stable = Some(s);
         self.since_estimate = 0;
         Ok(s)
