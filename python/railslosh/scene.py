@@ -791,6 +791,11 @@ def _bulkheads(value: Any, fieldname: str, half_length: float, n_length: int) ->
     return tuple(out)
 
 
+def _wall_damping_ratio(tk: Mapping[str, Any]) -> float:
+    """``[tank] wall_damping_ratio`` (vehicle and slosh scenes), default the library's."""
+    return _number(tk.get("wall_damping_ratio", vehicle.WALL_DAMPING_RATIO), "tank.wall_damping_ratio", 0.0, 10.0)
+
+
 def _fluid_spec(data: Mapping[str, Any], params: Mapping[str, float]) -> FluidSpec:
     fl = _table(data["fluid"], "fluid")
     _check_keys(fl, "fluid", ("oil", "fill", "model", "slosh_model", *_CUSTOM_KEYS))
@@ -804,7 +809,7 @@ def _fluid_spec(data: Mapping[str, Any], params: Mapping[str, float]) -> FluidSp
     _check_keys(tk, "tank", ("bulkheads", "wall_damping_ratio"))
     half = 0.5 * (params["tank_length"] - 1.0)
     bulkheads = _bulkheads(tk.get("bulkheads", []), "tank.bulkheads", half, counts[0])
-    zeta = _number(tk.get("wall_damping_ratio", vehicle.WALL_DAMPING_RATIO), "tank.wall_damping_ratio", 0.0, 10.0, "")
+    zeta = _wall_damping_ratio(tk)
     spec = FluidSpec(
         oil=oil,
         fill=fill,
@@ -1206,7 +1211,8 @@ def slosh_scene_from_dict(data: Mapping[str, Any]) -> SloshScene:
         for k, lo in (("viscous_points", 3), ("penalty_points", 2), ("contact_points_per_edge", 2))
     }
     tk = dict(_table(data.get("tank", {}), "tank"))
-    zeta = _number(tk.pop("wall_damping_ratio", vehicle.WALL_DAMPING_RATIO), "tank.wall_damping_ratio", 0.0, 10.0, "")
+    zeta = _wall_damping_ratio(tk)
+    tk.pop("wall_damping_ratio", None)
     tank = _slosh_tank(tk, counts)
     spec = FluidSpec(
         oil=oil, fill=fill, counts=counts, bulkheads=tank.bulkheads, custom=custom, wall_damping_ratio=zeta

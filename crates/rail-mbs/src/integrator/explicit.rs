@@ -285,6 +285,31 @@ impl<S: MechanicalSystem> Explicit<S> {
         self.system.forces(t, q, v, out).map_err(|source| IntegratorError::System { t, source })
     }
 
+    /// `y = M⁻¹ C x`, with `C x = −∂Q/∂v · x` by a directional difference at `(t, q, v)`
+    /// (`f0 = Q(t, q, v)`; `fp` is scratch).
+    #[allow(clippy::too_many_arguments)]
+    fn damping_times(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        f0: &[f64],
+        x: &[f64],
+        fp: &mut [f64],
+        y: &mut [f64],
+    ) -> Result<(), IntegratorError> {
+        let vmag = v.iter().fold(0.0_f64, |m, a| m.max(a.abs())).max(1.0);
+        let eps = 1e-7 * vmag;
+        let vp: Vec<f64> = v.iter().zip(x).map(|(a, b)| a + eps * b).collect();
+        self.eval(t, q, &vp, fp)?;
+        for i in 0..fp.len() {
+            fp[i] = -(fp[i] - f0[i]) / eps; // C x
+        }
+        self.mass.solve(fp, y);
+        self.stats.linear_solves += 1;
+        Ok(())
+    }
+
     /// Estimates the critical step at the current state (module docs); `iterations` power
     /// iterations from the last eigenvector.
     pub fn estimate_stable_step(&mut self, iterations: usize) -> Result<StableStep, IntegratorError> {
@@ -326,15 +351,7 @@ impl<S: MechanicalSystem> Explicit<S> {
         let omega = lambda.max(0.0).sqrt();
         let mut xi = 0.0;
         if omega > 0.0 {
-            let vmag = v.iter().fold(0.0_f64, |m, a| m.max(a.abs())).max(1.0);
-            let eps = 1e-7 * vmag;
-            let vp: Vec<f64> = v.iter().zip(&x).map(|(a, b)| a + eps * b).collect();
-            self.eval(t, &q, &vp, &mut fp)?;
-            for i in 0..n {
-                fp[i] = -(fp[i] - f0[i]) / eps; // C x
-            }
-            self.mass.solve(&fp, &mut y);
-            self.stats.linear_solves += 1;
+            self.damping_times(t, &q, &v, &f0, &x, &mut fp, &mut y)?;
             // M⁻¹C x ≈ 2 ξ ω x along the mode
             xi = (x.iter().zip(&y).map(|(a, b)| a * b).sum::<f64>() / (2.0 * omega)).max(0.0);
         }
@@ -346,7 +363,6 @@ impl<S: MechanicalSystem> Explicit<S> {
         }
         // μ_max: power iteration on M⁻¹C, C x by directional differences in v
         let mut x = std::mem::take(&mut self.damped_vector);
-        let vmag = v.iter().fold(0.0_f64, |m, a| m.max(a.abs())).max(1.0);
         let mut mu = 0.0;
         for _ in 0..iterations {
             let nx = norm(&x);
@@ -354,14 +370,7 @@ impl<S: MechanicalSystem> Explicit<S> {
                 break;
             }
             x.iter_mut().for_each(|a| *a /= nx);
-            let eps = 1e-7 * vmag;
-            let vp: Vec<f64> = v.iter().zip(&x).map(|(a, b)| a + eps * b).collect();
-            self.eval(t, &q, &vp, &mut fp)?;
-            for i in 0..n {
-                fp[i] = -(fp[i] - f0[i]) / eps; // C x
-            }
-            self.mass.solve(&fp, &mut y);
-            self.stats.linear_solves += 1;
+            self.damping_times(t, &q, &v, &f0, &x, &mut fp, &mut y)?;
             mu = x.iter().zip(&y).map(|(a, b)| a * b).sum::<f64>().abs().max(norm(&y));
             std::mem::swap(&mut x, &mut y);
         }
