@@ -93,3 +93,27 @@ def test_slosh_run_resumed_from_its_checkpoint_continues_bitwise(tmp_path):
         rs.slosh.run(mesh, water, tank, motion, t_end=0.6, h=0.004, resume_from=tmp_path / "none.ckpt")
     with pytest.raises(ValueError, match="checkpoint_every"):
         rs.slosh.run(mesh, water, tank, motion, t_end=0.6, h=0.004, checkpoint=ck, checkpoint_every=0)
+
+
+def test_fluid_vehicle_runs_record_their_invariants_per_car_and_sample(tmp_path):
+    """Issue 16 §1 for vehicle runs: every sample carries each car's containment gap, smallest
+    volume ratio and energy growth (the last accepted step; at t = 0 the initial state, growth 0),
+    in the results, the stream and the Dataset; the run's margins are their worst values or worse
+    (margins cover every step, samples a subset)."""
+    from railslosh import results
+
+    path = tmp_path / "fluid.jrnl"
+    res = vehicle.run_fluid(TRACK, cars=2, speed=40 / 3.6, t_end=0.2, counts=(2, 2, 2), stream=path)
+    s = vehicle.read_stream(path)
+    nt = len(res["t"])
+    for key in ("containment_gap", "min_volume_ratio", "energy_error"):
+        arr = np.asarray(res[key])
+        assert arr.shape == (nt, 2) and np.all(np.isfinite(arr)), key
+        assert np.array_equal(s[key], arr), key
+    m = res["margins"]
+    assert res["energy_error"][0].tolist() == [0.0, 0.0]
+    assert 0.0 <= res["containment_gap"].max() <= m["worst_gap"] < m["gap_limit"]
+    assert 1.0 >= res["min_volume_ratio"].min() >= m["min_volume_ratio"] > 0.9
+    assert res["energy_error"].max() <= max(m["worst_energy_error"], 0.0) + 1e-12
+    ds = results.to_dataset(res)
+    assert ds["containment_gap"].dims == ("time", "car") and ds["containment_gap"].attrs["units"] == "m"

@@ -123,6 +123,8 @@ def to_dataset(res: Mapping[str, Any], scene: Any = None) -> Any:
         if name not in res:
             continue
         arr = np.asarray(res[name])
+        if arr.ndim == len(dims) + 2 and "car" not in dims:
+            dims = ("car", *dims)  # the per-car series of a fluid vehicle run (e.g. containment_gap)
         if arr.shape[:1] != (nt,) or arr.ndim != len(dims) + 1:
             continue  # not a time series of the expected layout
         attrs = {"units": units, "long_name": long_name, **extra}

@@ -194,8 +194,10 @@ def run_fluid(
     ``fluid`` (a :class:`railslosh.Fluid`, e.g. from :mod:`railslosh.fluids`) overrides it.
     ``counts`` = fluid elements along the length, width and height; ``bulkheads`` = ``[(x, thickness)]``
     in the tank frame (m). Returns the arrays of :func:`run` plus ``oil_com_tank`` and ``oil_com_global``
-    (samples, cars, 3), ``fluid_force_tank`` (the fluid's load on each tank, tank frame), ``volume_error``
-    and ``snapshots`` (``[(t, [nodes x 4 x 3 per car])]``, position then gradients per node).
+    (samples, cars, 3), ``fluid_force_tank`` (the fluid's load on each tank, tank frame), ``volume_error``,
+    the run-time invariants per car and sample (``containment_gap`` in m, ``min_volume_ratio``,
+    ``energy_error``; worst values in ``margins``) and ``snapshots`` (``[(t, [nodes x 4 x 3 per
+    car])]``, position then gradients per node).
     ``progress`` and ``stream`` work as in :func:`run`. ``wall_damping_ratio`` (0 to 10, default
     :data:`WALL_DAMPING_RATIO`) is the damping ratio of the liquid column on the penalty wall
     spring: 1 (critical) removes most of the 20-30 Hz wall ringing from the loads after a wave
@@ -339,7 +341,8 @@ def read_stream(path: str | os.PathLike[str]) -> dict[str, Any]:
     run: every complete sample), as arrays shaped like the run's results: ``t``,
     ``wheel_vertical`` and ``wheel_lateral`` (samples, wheelsets, [left, right]),
     ``wheelset_lateral``, ``coupler_force``, ``tank_station``, ``tank_speed`` and, for fluid runs,
-    ``oil_com_tank``, ``fluid_force_tank`` (samples, cars, 3) and ``volume_error``."""
+    ``oil_com_tank``, ``fluid_force_tank`` (samples, cars, 3), ``volume_error``, ``containment_gap``,
+    ``min_volume_ratio`` and ``energy_error`` (samples, cars)."""
     import re
 
     from railslosh.journal import read_journal

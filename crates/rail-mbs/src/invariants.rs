@@ -240,6 +240,7 @@ pub struct InvariantMonitor {
     abs_work: f64,
     max_kinetic: f64,
     margins: Margins,
+    last_measured: Option<Measured>,
 }
 
 impl InvariantMonitor {
@@ -255,7 +256,13 @@ impl InvariantMonitor {
             abs_work: 0.0,
             max_kinetic: 0.0,
             margins: Margins { gap_limit: limits.containment, ..Margins::default() },
+            last_measured: None,
         }
+    }
+
+    /// What the last accounted state measured (None before the first).
+    pub fn last_measured(&self) -> Option<Measured> {
+        self.last_measured
     }
 
     /// The worst margins so far.
@@ -353,7 +360,9 @@ impl InvariantMonitor {
             m.worst_energy_time = p.t;
         }
         m.dissipated = self.e0.unwrap_or(p.total) + p.work - p.total;
-        Measured { gap: p.gap, min_volume_ratio: p.j, energy_error: p.eps, input_work: p.work }
+        let measured = Measured { gap: p.gap, min_volume_ratio: p.j, energy_error: p.eps, input_work: p.work };
+        self.last_measured = Some(measured);
+        measured
     }
 
     /// Keeps the worst gap and volume ratio.

@@ -286,8 +286,11 @@ fn fluid_record_dict<'py>(py: Python<'py>, r: &FluidTrainRecord) -> PyResult<Bou
     d.set_item("oil_com_tank", arr(py, flat(&r.oil_com_tank), &[nt, nc, 3])?)?;
     d.set_item("oil_com_global", arr(py, flat(&r.oil_com_global), &[nt, nc, 3])?)?;
     d.set_item("fluid_force_tank", arr(py, flat(&r.fluid_force_tank), &[nt, nc, 3])?)?;
-    let vol: Vec<f64> = r.volume_error.iter().flat_map(|s| s.iter().copied()).collect();
-    d.set_item("volume_error", arr(py, vol, &[nt, nc])?)?;
+    let per_car = |a: &Vec<Vec<f64>>| -> Vec<f64> { a.iter().flat_map(|s| s.iter().copied()).collect() };
+    d.set_item("volume_error", arr(py, per_car(&r.volume_error), &[nt, nc])?)?;
+    d.set_item("containment_gap", arr(py, per_car(&r.containment_gap), &[nt, nc])?)?;
+    d.set_item("min_volume_ratio", arr(py, per_car(&r.min_volume_ratio), &[nt, nc])?)?;
+    d.set_item("energy_error", arr(py, per_car(&r.energy_error), &[nt, nc])?)?;
     let snaps = pyo3::types::PyList::empty(py);
     for (t, cars) in &r.snapshots {
         let arrays: Vec<Bound<'py, PyAny>> =

@@ -32,7 +32,9 @@ use ancf_core::shape::N_SHAPE;
 use nalgebra::{Matrix3, Vector3};
 
 use crate::integrator::{KktIndex, MechanicalSystem, SparsityPattern, SystemError};
-use crate::invariants::{EnergySample, InvariantLimits, InvariantMonitor, Margins, Pending, stored_energy, wall_power};
+use crate::invariants::{
+    EnergySample, InvariantLimits, InvariantMonitor, Margins, Pending, check_state, stored_energy, wall_power,
+};
 use crate::mbs::{BodyId, BodyState, Multibody};
 
 /// Finite-difference steps for the tank coordinates and velocities.
@@ -613,6 +615,14 @@ pub struct FluidTrainRecord {
     pub fluid_force_tank: Vec<Vec<[f64; 3]>>,
     /// Relative fluid volume change: `[sample][car]`.
     pub volume_error: Vec<Vec<f64>>,
+    /// Run-time invariants of each car's fluid at each sample ([`crate::invariants`], the last
+    /// accepted step): largest wall gap of a node, contact point or the centre of mass (m),
+    /// `[sample][car]`.
+    pub containment_gap: Vec<Vec<f64>>,
+    /// Smallest volume ratio J at any quadrature or check point, `[sample][car]`.
+    pub min_volume_ratio: Vec<Vec<f64>>,
+    /// Energy growth ε of the fluid's energy account, `[sample][car]`.
+    pub energy_error: Vec<Vec<f64>>,
     /// Fluid mesh snapshots: time and the nodal coordinates of every car's fluid (global,
     /// the layout of `FluidBody` coordinates: 12 per node, position first).
     pub snapshots: Vec<(f64, Vec<Vec<f64>>)>,
@@ -629,14 +639,16 @@ pub struct FluidTrainRecord {
 
 impl FluidTrainRecord {
     /// Column names of [`Self::row`]: the [`TrainRecord::columns`] followed, per car, by the
-    /// oil centre of mass (tank frame), the fluid force on the tank (tank frame) and the
-    /// relative volume change.
+    /// oil centre of mass (tank frame), the fluid force on the tank (tank frame), the
+    /// relative volume change and the invariants (containment gap, smallest volume ratio,
+    /// energy growth).
     pub fn columns(wheelsets: usize, couplers: usize, cars: usize) -> Vec<String> {
         let mut c = TrainRecord::columns(wheelsets, couplers, cars);
         for k in 0..cars {
             c.extend(["x", "y", "z"].map(|a| format!("oil_com_tank[{k}].{a}")));
             c.extend(["x", "y", "z"].map(|a| format!("fluid_force_tank[{k}].{a}")));
             c.push(format!("volume_error[{k}]"));
+            c.extend(["containment_gap", "min_volume_ratio", "energy_error"].map(|n| format!("{n}[{k}]")));
         }
         c
     }
@@ -662,6 +674,9 @@ impl FluidTrainRecord {
         self.oil_com_global.clear();
         self.fluid_force_tank.clear();
         self.volume_error.clear();
+        self.containment_gap.clear();
+        self.min_volume_ratio.clear();
+        self.energy_error.clear();
     }
 
     /// Sample `i` as one flat row in the order of [`Self::columns`].
@@ -671,6 +686,7 @@ impl FluidTrainRecord {
             r.extend(self.oil_com_tank[i][k]);
             r.extend(self.fluid_force_tank[i][k]);
             r.push(self.volume_error[i][k]);
+            r.extend([self.containment_gap[i][k], self.min_volume_ratio[i][k], self.energy_error[i][k]]);
         }
         r
     }
@@ -740,9 +756,25 @@ fn record_fluid(sys: &FluidVehicle, q: &[f64], v: &[f64], rec: &mut FluidTrainRe
     let mut com_g = Vec::new();
     let mut load = Vec::new();
     let mut vol = Vec::new();
+    let (mut gap, mut ratio, mut eps) = (Vec::new(), Vec::new(), Vec::new());
     for (k, f) in sys.fluids.iter().enumerate() {
         let s = sys.mb.state(Some(f.tank), &q[..nr], &v[..nr]);
         let e = sys.fluid_slice(k, q);
+        let (g, j, eps_k) = match sys.monitors[k].last_measured() {
+            Some(m) => (m.gap, m.min_volume_ratio, m.energy_error),
+            // the initial state, before any step: measured here; the energy account starts at
+            // the first accepted step, so its growth is 0 by definition
+            None => {
+                let monitor = &sys.monitors[k];
+                let kin = tank_kinematics(&s);
+                let (g, j) = check_state(|| monitor.name.clone(), &f.body, &f.contact, &kin, e, &monitor.limits)
+                    .unwrap_or_else(|(_, g, j)| (g, j));
+                (g, j, 0.0)
+            }
+        };
+        gap.push(g);
+        ratio.push(j);
+        eps.push(eps_k);
         let c = Vector3::from(f.body.center_of_mass(e));
         com.push(<[f64; 3]>::from(s.rotation.transpose() * (c - s.position)));
         com_g.push(<[f64; 3]>::from(c));
@@ -754,6 +786,9 @@ fn record_fluid(sys: &FluidVehicle, q: &[f64], v: &[f64], rec: &mut FluidTrainRe
     rec.oil_com_global.push(com_g);
     rec.fluid_force_tank.push(load);
     rec.volume_error.push(vol);
+    rec.containment_gap.push(gap);
+    rec.min_volume_ratio.push(ratio);
+    rec.energy_error.push(eps);
 }
 
 /// Runs a train with fluid cargo; on failure returns what was recorded with the error.
