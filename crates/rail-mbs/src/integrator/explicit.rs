@@ -157,6 +157,19 @@ pub struct StableStep {
     pub critical: f64,
 }
 
+/// The operator of a power iteration (M⁻¹K or M⁻¹C).
+#[derive(Debug, Clone, Copy)]
+enum Operator {
+    /// K = −∂Q/∂q.
+    Stiffness,
+    /// C = −∂Q/∂v.
+    Damping,
+}
+
+fn norm(x: &[f64]) -> f64 {
+    x.iter().map(|a| a * a).sum::<f64>().sqrt()
+}
+
 /// Explicit central-difference stepper of a constant-mass system (module docs).
 pub struct Explicit<S: MechanicalSystem> {
     system: S,
@@ -285,11 +298,12 @@ impl<S: MechanicalSystem> Explicit<S> {
         self.system.forces(t, q, v, out).map_err(|source| IntegratorError::System { t, source })
     }
 
-    /// `y = M⁻¹ C x`, with `C x = −∂Q/∂v · x` by a directional difference at `(t, q, v)`
+    /// `y = M⁻¹ A x`, A = K = −∂Q/∂q or C = −∂Q/∂v, by a directional difference at `(t, q, v)`
     /// (`f0 = Q(t, q, v)`; `fp` is scratch).
     #[allow(clippy::too_many_arguments)]
-    fn damping_times(
+    fn apply(
         &mut self,
+        op: Operator,
         t: f64,
         q: &[f64],
         v: &[f64],
@@ -298,16 +312,56 @@ impl<S: MechanicalSystem> Explicit<S> {
         fp: &mut [f64],
         y: &mut [f64],
     ) -> Result<(), IntegratorError> {
-        let vmag = v.iter().fold(0.0_f64, |m, a| m.max(a.abs())).max(1.0);
-        let eps = 1e-7 * vmag;
-        let vp: Vec<f64> = v.iter().zip(x).map(|(a, b)| a + eps * b).collect();
-        self.eval(t, q, &vp, fp)?;
+        let size = |z: &[f64]| z.iter().fold(0.0_f64, |m, a| m.max(a.abs())).max(1.0);
+        let eps = match op {
+            Operator::Stiffness => {
+                let eps = 1e-7 * size(q);
+                let qp: Vec<f64> = q.iter().zip(x).map(|(a, b)| a + eps * b).collect();
+                self.eval(t, &qp, v, fp)?;
+                eps
+            }
+            Operator::Damping => {
+                let eps = 1e-7 * size(v);
+                let vp: Vec<f64> = v.iter().zip(x).map(|(a, b)| a + eps * b).collect();
+                self.eval(t, q, &vp, fp)?;
+                eps
+            }
+        };
         for i in 0..fp.len() {
-            fp[i] = -(fp[i] - f0[i]) / eps; // C x
+            fp[i] = -(fp[i] - f0[i]) / eps; // A x
         }
         self.mass.solve(fp, y);
         self.stats.linear_solves += 1;
         Ok(())
+    }
+
+    /// `iterations` power iterations on M⁻¹A (A as in [`Self::apply`]) from `x` (left
+    /// unnormalized, for the next estimate's warm start); the dominant eigenvalue.
+    #[allow(clippy::too_many_arguments)]
+    fn dominant(
+        &mut self,
+        op: Operator,
+        x: &mut Vec<f64>,
+        iterations: usize,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        f0: &[f64],
+    ) -> Result<f64, IntegratorError> {
+        let n = x.len();
+        let (mut fp, mut y) = (vec![0.0; n], vec![0.0; n]);
+        let mut lambda = 0.0;
+        for _ in 0..iterations {
+            let nx = norm(x);
+            if nx.is_nan() || nx <= 0.0 {
+                break;
+            }
+            x.iter_mut().for_each(|a| *a /= nx);
+            self.apply(op, t, q, v, f0, x, &mut fp, &mut y)?;
+            lambda = x.iter().zip(&y).map(|(a, b)| a * b).sum::<f64>().abs().max(norm(&y));
+            std::mem::swap(x, &mut y);
+        }
+        Ok(lambda)
     }
 
     /// Estimates the critical step at the current state (module docs); `iterations` power
@@ -317,32 +371,8 @@ impl<S: MechanicalSystem> Explicit<S> {
         let (t, q, v) = (self.t, self.q.clone(), self.v.clone());
         let mut f0 = vec![0.0; n];
         self.eval(t, &q, &v, &mut f0)?;
-        let scale = q.iter().fold(0.0_f64, |m, x| m.max(x.abs())).max(1.0);
         let mut x = std::mem::take(&mut self.eigenvector);
-        let mut qp = vec![0.0; n];
-        let mut fp = vec![0.0; n];
-        let mut y = vec![0.0; n];
-        let mut lambda = 0.0;
-        let norm = |x: &[f64]| x.iter().map(|a| a * a).sum::<f64>().sqrt();
-        for _ in 0..iterations {
-            let nx = norm(&x);
-            if nx.is_nan() || nx <= 0.0 {
-                break;
-            }
-            x.iter_mut().for_each(|a| *a /= nx);
-            let eps = 1e-7 * scale;
-            for i in 0..n {
-                qp[i] = q[i] + eps * x[i];
-            }
-            self.eval(t, &qp, &v, &mut fp)?;
-            for i in 0..n {
-                fp[i] = -(fp[i] - f0[i]) / eps; // K x
-            }
-            self.mass.solve(&fp, &mut y);
-            self.stats.linear_solves += 1;
-            lambda = x.iter().zip(&y).map(|(a, b)| a * b).sum::<f64>().abs().max(norm(&y));
-            std::mem::swap(&mut x, &mut y);
-        }
+        let lambda = self.dominant(Operator::Stiffness, &mut x, iterations, t, &q, &v, &f0)?;
         let nx = norm(&x);
         if nx > 0.0 {
             x.iter_mut().for_each(|a| *a /= nx);
@@ -351,7 +381,8 @@ impl<S: MechanicalSystem> Explicit<S> {
         let omega = lambda.max(0.0).sqrt();
         let mut xi = 0.0;
         if omega > 0.0 {
-            self.damping_times(t, &q, &v, &f0, &x, &mut fp, &mut y)?;
+            let (mut fp, mut y) = (vec![0.0; n], vec![0.0; n]);
+            self.apply(Operator::Damping, t, &q, &v, &f0, &x, &mut fp, &mut y)?;
             // M⁻¹C x ≈ 2 ξ ω x along the mode
             xi = (x.iter().zip(&y).map(|(a, b)| a * b).sum::<f64>() / (2.0 * omega)).max(0.0);
         }
@@ -361,19 +392,9 @@ impl<S: MechanicalSystem> Explicit<S> {
                 what: format!("stable-step estimate at t = {t} s: no positive stiffness found (ω² = {lambda})"),
             });
         }
-        // μ_max: power iteration on M⁻¹C, C x by directional differences in v
+        // μ_max: power iteration on M⁻¹C
         let mut x = std::mem::take(&mut self.damped_vector);
-        let mut mu = 0.0;
-        for _ in 0..iterations {
-            let nx = norm(&x);
-            if nx.is_nan() || nx <= 0.0 {
-                break;
-            }
-            x.iter_mut().for_each(|a| *a /= nx);
-            self.damping_times(t, &q, &v, &f0, &x, &mut fp, &mut y)?;
-            mu = x.iter().zip(&y).map(|(a, b)| a * b).sum::<f64>().abs().max(norm(&y));
-            std::mem::swap(&mut x, &mut y);
-        }
+        let mu = self.dominant(Operator::Damping, &mut x, iterations, t, &q, &v, &f0)?;
         self.damped_vector = x;
         let mu = if mu.is_finite() { mu } else { 0.0 };
         let critical = (2.0 / omega * ((1.0 + xi * xi).sqrt() - xi)).min(2.0 / (omega + mu));
