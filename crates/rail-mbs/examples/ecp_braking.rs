@@ -19,7 +19,7 @@ fn main() {
     let s = &r.train;
     let peak = s.coupler_force.iter().map(|c| c[0].abs()).fold(0.0, f64::max);
     println!(
-        "{} crude, {:?}, {} elements/tank, {:.1} s simulated: wall {:.1} s ({:.3} sim s per wall s), steps {} (rejected {}), Newton {} ({:.2}/step), Jacobians {}, peak |coupler| {:.0} N, final speed {:.2} km/h, max |volume error| {:.2e}",
+        "{} crude, {:?}, {} elements/tank, {:.1} s simulated: wall {:.1} s ({:.3} sim s per wall s), steps {} (rejected {}), Newton {} ({:.2}/step), Jacobians {}, time in assembly / factorization / solves {:.1} / {:.1} / {:.1} s, peak |coupler| {:.0} N, final speed {:.2} km/h, max |volume error| {:.2e}",
         oil.name(),
         scope,
         r.elements,
@@ -31,6 +31,9 @@ fn main() {
         s.newton_iterations,
         s.newton_iterations as f64 / s.steps as f64,
         s.jacobian_evaluations,
+        s.time_split[0],
+        s.time_split[1],
+        s.time_split[2],
         peak,
         s.tank_speed.last().map_or(f64::NAN, |v| v[0] * 3.6),
         r.volume_error.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()))

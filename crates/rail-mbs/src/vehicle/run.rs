@@ -154,6 +154,9 @@ pub struct TrainRecord {
     pub jacobian_evaluations: usize,
     /// Wall time, s.
     pub wall_time: f64,
+    /// Where the integrator's time went, s: system callbacks and assembly (forces,
+    /// Jacobians), numeric factorizations, linear solves ([`crate::integrator::Stats`]).
+    pub time_split: [f64; 3],
     /// Degrees of freedom of the model.
     pub dof: isize,
 }
@@ -166,6 +169,11 @@ impl TrainRecord {
             self.steps = s.steps;
             self.rejected_steps = s.rejected_steps;
             self.jacobian_evaluations = s.jacobian_evaluations;
+            self.time_split = [
+                s.time_assembly.as_secs_f64(),
+                s.time_factorization.as_secs_f64(),
+                s.time_solve.as_secs_f64(),
+            ];
         }
         self.wall_time = start.elapsed().as_secs_f64();
     }
