@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from railslosh import validate
+from railslosh.constants import GRAVITY
 from railslosh.cosim import (
     CentrifugeArm,
     PendulumSlosh,
@@ -26,7 +27,7 @@ from railslosh.cosim.emulators import rectangular_modes, segment_geometry, smoot
 from railslosh.cosim.masters import Accelerator
 from railslosh.cosim.protocol import check_motion
 
-G = 9.81
+G = GRAVITY
 
 
 def rest_motion(**kw):

@@ -13,6 +13,7 @@ from hypothesis import strategies as st
 
 import railslosh
 from railslosh import rail, results, scene
+from railslosh.constants import GRAVITY
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = sorted((ROOT / "examples" / "scenes").glob("*.toml"))
@@ -397,7 +398,7 @@ def test_custom_fluid_is_built_and_checked():
     sc = scene.load_scene(doc)
     f = sc.fluid.make_fluid(1.5)
     assert f.density == 950.0 and f.model == "bingham" and f.yield_stress == 10.0
-    assert f.bulk_penalty == pytest.approx(1000 * 950.0 * 9.81 * 1.5)
+    assert f.bulk_penalty == pytest.approx(1000 * 950.0 * GRAVITY * 1.5)
     with pytest.raises(ValueError, match=r"invalid parameter `fluid.model`"):
         scene.load_scene(_set_dotted(doc, "fluid.model", "maxwell"))
     with pytest.raises(ValueError, match=r"invalid parameter `fluid.model`"):
@@ -532,7 +533,7 @@ def test_a_raising_progress_callback_stops_the_run(which):
 
 
 @pytest.mark.parametrize(
-    ("axis", "accel", "factor"), [("z", 2 * 9.81, 3.0), ("z", -0.5 * 9.81, 1.0), ("y", 0.3 * 9.81, 1.0440307)]
+    ("axis", "accel", "factor"), [("z", 2 * GRAVITY, 3.0), ("z", -0.5 * GRAVITY, 1.0), ("y", 0.3 * GRAVITY, 1.0440307)]
 )
 def test_slosh_penalty_follows_the_largest_apparent_gravity(axis, accel, factor):
     """k = 1000 rho g H x max |g - a| / g (at least 1): the volume strain stays 1e-3 at the peak."""
@@ -540,7 +541,7 @@ def test_slosh_penalty_follows_the_largest_apparent_gravity(axis, accel, factor)
     sc = scene.load_scene(doc)
     assert sc.peak_load_factor() == pytest.approx(factor, rel=1e-6)  # at rest (t = 0) it is 1
     (_mesh, fluid, _tank, _motion), _kw = sc.run_args()
-    expected = 1000.0 * 998.0 * 9.81 * sc.depth() * max(sc.peak_load_factor(), 1.0)
+    expected = 1000.0 * 998.0 * GRAVITY * sc.depth() * max(sc.peak_load_factor(), 1.0)
     assert fluid.bulk_penalty == pytest.approx(expected, rel=1e-9)
     custom = _set_dotted(doc, "fluid", {"oil": "custom", "model": "newtonian", "density": 998.0, "bulk_penalty": 5e6})
     (_m, f2, _t, _mo), _ = scene.load_scene(custom).run_args()

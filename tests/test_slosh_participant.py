@@ -5,8 +5,9 @@ import numpy as np
 import pytest
 
 from railslosh import _core
+from railslosh.constants import GRAVITY
 
-G = 9.81
+G = GRAVITY
 L = (0.4, 0.3, 0.1)
 TANK = [-0.2, -0.15, 0.0, 0.2, 0.15, 0.25]
 

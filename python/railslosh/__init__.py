@@ -5,7 +5,7 @@ analysis and the ``railslosh`` command-line tool. Units are SI throughout; frame
 conventions are defined in ``docs/frames.md``.
 """
 
-from railslosh import fluids, mesh, rail, scene, slosh, vehicle
+from railslosh import constants, fluids, mesh, rail, scene, slosh, vehicle
 from railslosh._core import (
     Fluid,
     FluidBody,
@@ -21,6 +21,7 @@ __all__ = [
     "FluidMesh",
     "RailsloshError",
     "__version__",
+    "constants",
     "fluids",
     "mass_matrix",
     "mesh",

@@ -13,6 +13,11 @@ _Progress = Callable[[float, float, int, int, int], object]
 """Progress callback of the runs: ``(t, t_end, steps, newton_iterations, rejected_steps)``."""
 
 WALL_DAMPING_RATIO: float
+GRAVITY: float
+FOOT: float
+INCH: float
+MPH: float
+ARC_DEGREE_RADIUS_FT: float
 
 class RailsloshError(Exception):
     """Base class of railslosh simulation errors."""
@@ -408,7 +413,7 @@ class SloshParticipant:
         bulkheads: list[tuple[float, float]] = ...,
         h_max: float = 0.005,
         reference_point: tuple[float, float, float] | list[float] = ...,
-        gravity: float = 9.81,
+        gravity: float = ...,
         t0: float = 0.0,
         viscous_points: int = 3,
         penalty_points: int = 3,
@@ -433,6 +438,8 @@ class SloshParticipant:
     @property
     def reference_point(self) -> npt.NDArray[np.float64]: ...
     @property
+    def gravity(self) -> float: ...
+    @property
     def h_max(self) -> float: ...
     @property
     def margins(self) -> dict[str, Any]: ...
@@ -440,7 +447,7 @@ class SloshParticipant:
     def stats(self) -> dict[str, Any]: ...
 
 def seed003_maneuvers(
-    dt: float = 0.005, t_after: float = 2.0, gravity: float = 9.81, t_before: float = 0.5
+    dt: float = 0.005, t_after: float = 2.0, gravity: float = ..., t_before: float = 0.5
 ) -> list[dict[str, Any]]: ...
 def maneuver_defaults() -> dict[str, dict[str, float]]: ...
 def maneuver_motion(spec: Mapping[str, Any], t0: float, t_end: float, dt: float = 1e-3) -> dict[str, Any]: ...

@@ -10,6 +10,8 @@ import time
 from pathlib import Path
 from typing import Any
 
+from railslosh.constants import GRAVITY
+
 
 def _cmd_validate(args: argparse.Namespace) -> int:
     from railslosh import validate
@@ -90,7 +92,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     # braking: the car decelerates at 0.1 g (about 40 -> 5 km/h in 10 s) from t = 0.2 s
     run_mesh = rs.mesh.cylinder_tank(fill=args.fill, n_length=args.n_length, n_width=2, n_height=2)
     tank = rs.slosh.cylinder_tank(rs.mesh.TANK_CAR_LENGTH, rs.mesh.TANK_CAR_RADIUS, rs.mesh.TANK_CAR_HEAD_DEPTH)
-    motion = rs.slosh.Motion().pulse("x", -0.1 * 9.81, 0.2, 100.0, ramp=0.2)
+    motion = rs.slosh.Motion().pulse("x", -0.1 * GRAVITY, 0.2, 100.0, ramp=0.2)
     print(
         f"  braking run: -0.1 g from t = 0.2 s for {args.t_end} s, {run_mesh.n_elements} bricks "
         f"({run_mesh.n_coords} coordinates), HHT, penalty wall contact"

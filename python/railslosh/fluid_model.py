@@ -40,6 +40,7 @@ from typing import Any
 import numpy as np
 
 from railslosh import rail, vehicle
+from railslosh.constants import GRAVITY
 
 __all__ = [
     "DYNAMIC_FACTOR",
@@ -60,7 +61,7 @@ DYNAMIC_FACTOR = 2.0
 RISE_LIMIT_FRACTION = 0.5
 """Largest linear free-surface rise, as a fraction of ``min(h, 2R - h)``, left to the pendulum model."""
 CANT_BASE = rail.DEFAULT_CANT_BASE
-G = rail.GRAVITY
+G = GRAVITY
 
 
 @dataclass(frozen=True)

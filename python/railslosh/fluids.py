@@ -8,8 +8,7 @@ Penalty parameters (seed 000 §4.1): ``bulk_penalty`` k_IC is a bulk modulus (Pa
 from __future__ import annotations
 
 from railslosh._core import Fluid
-
-GRAVITY = 9.81
+from railslosh.constants import GRAVITY
 
 #: Seed 000 Table 2: density (kg/m^3), dynamic viscosity (Pa s), yield stress (Pa).
 CRUDE_OILS: dict[str, tuple[float, float, float]] = {

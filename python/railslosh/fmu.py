@@ -7,7 +7,7 @@ runs the FMU, and ``case_fmu_roundtrip`` is the validation case ``fmu-fmpy-round
 Variables (all in the tank frame, SI units; loads are those of the fluid on the tank):
 
 - inputs ``a_x..z`` (tank origin acceleration without gravity), ``omega_x..z``, ``omega_dot_x..z``,
-  ``gravity_x..z`` (default (0, 0, -9.81));
+  ``gravity_x..z`` (default (0, 0, -g0), g0 = 9.80665);
 - outputs ``F_x..z``, ``M_x..z`` (about ``ref_x..z``), ``com_x..z``;
 - parameters ``model`` (0 pendulum, 1 ANCF), ``fill``, ``density``, ``viscosity``, ``length``,
   ``semi_axis_y``, ``semi_axis_z``, ``ref_x..z``, ``h_max``, ``damping_ratio``, ``n_length``,
@@ -24,9 +24,10 @@ from pathlib import Path
 
 import numpy as np
 
+from railslosh.constants import GRAVITY
+
 INPUTS = tuple(f"{g}_{c}" for g in ("a", "omega", "omega_dot", "gravity") for c in "xyz")
 OUTPUTS = tuple(f"{g}_{c}" for g in ("F", "M", "com") for c in "xyz")
-GRAVITY = 9.81
 # default tank of the FMU: the SwRI elliptical tank of seed 003, half full of water
 SWRI = {"length": 0.324, "semi_axis_y": 0.208585, "semi_axis_z": 0.132131}
 
@@ -81,7 +82,7 @@ def find_fmu(build: bool = True, debug: bool = False) -> Path:
 def tank_motion(t, **columns) -> np.ndarray:
     """Tabulated tank motion as an FMPy input signal: a structured array with ``time`` and every
     input, the given ones at the times ``t`` (FMPy interpolates linearly between rows), the others
-    at their defaults (zero; ``gravity_z`` = -9.81)."""
+    at their defaults (zero; ``gravity_z`` = -g0)."""
     t = np.asarray(t, dtype=float)
     if t.ndim != 1 or t.size < 1 or np.any(np.diff(t) < 0) or not np.all(np.isfinite(t)):
         raise ValueError("invalid parameter `t`: allowed a non-decreasing 1-D array of finite times")

@@ -32,13 +32,12 @@ import numpy as np
 import numpy.typing as npt
 
 from railslosh import _core
+from railslosh.constants import GRAVITY
 
 STANDARD_GAUGE = 1.435
 """Standard gauge, m."""
 DEFAULT_CANT_BASE = 1.5
 """Default base over which super-elevation is measured, m."""
-GRAVITY = 9.80665
-"""Standard gravity used by :meth:`Track.balance_speed`, m/s^2."""
 
 FloatArray = npt.NDArray[np.float64]
 ArrayLike = float | Sequence[float] | npt.NDArray[Any]

@@ -85,6 +85,7 @@ from typing import Any
 import numpy as np
 
 from railslosh import rail, vehicle
+from railslosh.constants import GRAVITY
 
 __all__ = [
     "OILS",
@@ -976,8 +977,8 @@ class SloshScene:
             pts = mo.acceleration.get(ax)
             if pts:
                 acc[:, i] = np.interp(times, [p[0] for p in pts], [p[1] for p in pts])
-        g = np.array([0.0, 0.0, -9.81])
-        return float(np.linalg.norm(g - acc, axis=1).max() / 9.81)
+        g = np.array([0.0, 0.0, -GRAVITY])
+        return float(np.linalg.norm(g - acc, axis=1).max() / GRAVITY)
 
     def run_args(self) -> tuple[tuple[Any, ...], dict[str, Any]]:
         """Positional and keyword arguments of :func:`railslosh.slosh.run`. Unless the scene sets
@@ -987,7 +988,7 @@ class SloshScene:
         depth = self.depth()
         spec = self.fluid
         if "bulk_penalty" not in spec.custom:
-            k = 1000.0 * spec.density() * 9.81 * depth * max(1.0, self.peak_load_factor())
+            k = 1000.0 * spec.density() * GRAVITY * depth * max(1.0, self.peak_load_factor())
             spec = dataclasses.replace(spec, custom={**spec.custom, "bulk_penalty": k})
         fluid = spec.make_fluid(depth, depth / spec.counts[2])
         kw: dict[str, Any] = {

@@ -3,7 +3,7 @@
     >>> import railslosh as rs
     >>> mesh = rs.mesh.box((0.416, 0.324, 0.132), (3, 6, 2))
     >>> tank = rs.slosh.box_tank((-0.208, -0.162, 0.0), (0.208, 0.162, 0.3))
-    >>> motion = rs.slosh.Motion().pulse("y", 0.3 * 9.81, 0.0, 0.5)
+    >>> motion = rs.slosh.Motion().pulse("y", 0.3 * rs.constants.GRAVITY, 0.0, 0.5)
     >>> res = rs.slosh.run(mesh, rs.fluids.water(depth=0.132), tank, motion, t_end=2.0, h=0.004)
     >>> res["force_tank"].shape  # (steps + 1, 3): load of the fluid on the tank, tank axes
 
@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 
 from railslosh import _core
 from railslosh._core import Fluid, FluidMesh, RailsloshError
+from railslosh.constants import GRAVITY
 
 AXES = {"x": 0, "y": 1, "z": 2}
 
@@ -110,7 +111,7 @@ def run(
     t_end: float,
     h: float = 0.01,
     frame: str = "inertial",
-    gravity: tuple[float, float, float] = (0.0, 0.0, -9.81),
+    gravity: tuple[float, float, float] = (0.0, 0.0, -GRAVITY),
     progress: Callable[[float, float, int, int, int], object] | None = None,
     volume_tolerance: float = 0.01,
     penetration_limit: float = 0.5,

@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from railslosh.constants import GRAVITY
 from railslosh.slosh import FAILURE_CAUSES, failure_cause
 
 #: Failure causes and their message patterns (see :func:`railslosh.slosh.failure_cause`).
@@ -35,7 +36,7 @@ CAUSES = FAILURE_CAUSES
 #: Relative volume error above which a completed run is a bug.
 VOLUME_TOLERANCE = 0.01
 
-G = 9.81
+G = GRAVITY
 
 
 def classify(message: str) -> str:

@@ -20,6 +20,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod body;
+pub mod constants;
 pub mod constitutive;
 pub mod contact;
 pub mod element;

@@ -159,7 +159,7 @@ fn element_mass() -> Result<Vec<Record>> {
         tolerance: 0.0,
         passed: lmin > 0.0,
     });
-    let g = 9.80665;
+    let g = crate::constants::GRAVITY;
     let gs = el.gravity_scale(rho, &tables);
     out.push(Record::abs(c, "gravity force, position entry (N): -rho V g / 8", -gs[0] * g, -rho * g / 8.0, 1e-8));
     out.push(Record::abs(

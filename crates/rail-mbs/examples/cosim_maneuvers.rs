@@ -13,12 +13,13 @@
 //! centre of mass (cx cy cz, tank frame). Maneuver definitions: `rail_mbs::maneuvers` (the same motions as the shipped `swri_*` scenes).
 use std::io::Write;
 
+use ancf_core::constants::GRAVITY as G;
 use ancf_core::constitutive::Rheology;
 use ancf_core::mesh::{EllipticCylinderSpec, elliptic_cylinder};
 use ancf_core::tank::{TankGeometry, TankShape};
 use rail_mbs::cosim::maneuvers::seed003_maneuvers;
 use rail_mbs::cosim::{SloshParticipant, SloshParticipantConfig, TankMotionInput};
-use rail_mbs::slosh::validate::{G, liquid};
+use rail_mbs::slosh::validate::liquid;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<(String, String)> = std::env::args()

@@ -23,7 +23,7 @@ use rail_mbs::slosh::validate::{dominant_frequency, liquid, slosh_params};
 use rail_mbs::slosh::{PiecewiseAcceleration, PrescribedMotion, SloshFrame, SloshRecord, SloshRun, SloshSystem};
 use rail_mbs::vehicle::studies::Oil;
 
-const G: f64 = 9.81;
+use ancf_core::constants::GRAVITY as G;
 const L: [f64; 3] = [0.416, 0.324, 0.132];
 
 /// The test tank with the penalty bulk modulus `bulk` × the default k_IC = 1000 ρ g H (the
@@ -140,7 +140,8 @@ fn tank_car_tank(zeta_w: f64, penalty_damping: bool) -> SloshSystem {
         fluid.bulk_damping = 0.0;
     }
     let body = FluidBody::new(mesh, fluid, QuadratureOptions { penalty: 4, ..QuadratureOptions::default() }).unwrap();
-    let geo = TankGeometry::new(TankShape::Cylinder { length: spec.length, radius: r, head_depth: head }, vec![]).unwrap();
+    let geo =
+        TankGeometry::new(TankShape::Cylinder { length: spec.length, radius: r, head_depth: head }, vec![]).unwrap();
     let mut law = WallContactLaw::default_for(fluid.density, g, depth)
         .with_damping_ratio(zeta_w, fluid.density, g, depth)
         .unwrap();
@@ -188,7 +189,8 @@ fn tank_car(t_end: f64) {
         let sys = tank_car_tank(zeta_w, pd);
         let (q, v) = sys.initial_state(0.0);
         let m_s = sys.body.scalar_mass().clone();
-        let mut e = rail_mbs::integrator::Explicit::new(sys.clone(), &m_s, 0.0, q, v, ExplicitParams::default()).unwrap();
+        let mut e =
+            rail_mbs::integrator::Explicit::new(sys.clone(), &m_s, 0.0, q, v, ExplicitParams::default()).unwrap();
         let s = e.estimate_stable_step(200).unwrap();
         let tic = Instant::now();
         let mut r = SloshRun::new_explicit(sys, 0.0, ExplicitParams::default()).unwrap();
@@ -255,7 +257,8 @@ fn main() {
             }
             let (rec, steps, forces) = last.unwrap();
             let (c, f) = (com(&rec), fy(&rec));
-            let com_err = rec.t.iter().zip(&c).map(|(t, x)| (x - interp(&reference, &rc, *t)).abs()).fold(0.0, f64::max);
+            let com_err =
+                rec.t.iter().zip(&c).map(|(t, x)| (x - interp(&reference, &rc, *t)).abs()).fold(0.0, f64::max);
             let f1 = dominant_frequency(&rec.t, &f, 0.6, 0.5, 4.0);
             println!(
                 "{{\"case\": \"rect_pulse_0.3g_4s\", \"mesh\": {counts:?}, \"bulk_factor\": {bulk}, \"stepper\": \"{name}\", \"h_record\": {h}, \

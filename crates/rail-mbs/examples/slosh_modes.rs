@@ -8,6 +8,7 @@
 //! newton shift (static Newton refinement steps and their mass shift) list (1: list all modes
 //! with lambda < 3).
 use ancf_core::FluidBody;
+use ancf_core::constants::GRAVITY as G;
 use ancf_core::constitutive::Rheology;
 use ancf_core::contact::{WallContact, WallContactLaw};
 use ancf_core::element::QuadratureOptions;
@@ -16,7 +17,7 @@ use ancf_core::tank::{TankGeometry, TankShape};
 use faer::linalg::solvers::Solve;
 use faer::{Mat, Par, Side};
 use rail_mbs::integrator::{HhtParams, MechanicalSystem};
-use rail_mbs::slosh::validate::{G, liquid, slosh_params};
+use rail_mbs::slosh::validate::{liquid, slosh_params};
 use rail_mbs::slosh::{PrescribedMotion, SloshFrame, SloshRun, SloshSystem};
 
 fn main() {

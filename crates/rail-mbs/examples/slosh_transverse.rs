@@ -5,12 +5,13 @@
 //! kc (contact stiffness factor; the damping scales as kc^cexp, default 1.5) easy maxit.
 //! Defaults are the default discretization on 1x8x4; `amp=0` leaves the tank at rest.
 use ancf_core::FluidBody;
+use ancf_core::constants::GRAVITY as G;
 use ancf_core::constitutive::Rheology;
 use ancf_core::contact::{WallContact, WallContactLaw};
 use ancf_core::element::QuadratureOptions;
 use ancf_core::mesh::{CylinderTankSpec, cylinder_tank};
 use ancf_core::tank::{TankGeometry, TankShape};
-use rail_mbs::slosh::validate::{G, liquid, slosh_params};
+use rail_mbs::slosh::validate::{liquid, slosh_params};
 use rail_mbs::slosh::{PiecewiseAcceleration, PrescribedMotion, SloshFrame, SloshRun, SloshSystem};
 use std::io::Write;
 

@@ -52,14 +52,7 @@
 use nalgebra::{Matrix3, Vector3};
 use thiserror::Error;
 
-/// Standard gravity used by [`Track::balance_speed`], m/s².
-pub const GRAVITY: f64 = 9.80665;
-/// One foot in metres.
-pub const FOOT: f64 = 0.3048;
-/// One inch in metres.
-pub const INCH: f64 = 0.0254;
-/// One mile per hour in metres per second.
-pub const MPH: f64 = 0.44704;
+pub use ancf_core::constants::{FOOT, GRAVITY, INCH, MPH};
 /// Radius, in feet, of a 1° curve with the arc definition (100 ft of arc per degree).
 pub const ARC_DEGREE_RADIUS_FT: f64 = 5_729.577_951_308_232;
 

@@ -31,7 +31,7 @@ use crate::slosh::{PiecewiseAcceleration, PrescribedMotion, SloshFrame, SloshRec
 use crate::vehicle::BrakeScope;
 use crate::vehicle::studies::{BrakingCase, Oil, SETTLE, run_braking_with};
 
-const G: f64 = 9.81;
+use ancf_core::constants::GRAVITY as G;
 
 /// Names of the sweeps.
 pub const CASES: [&str; 3] = ["slosh-tank", "ecp-braking", "ecp-braking-spread"];

@@ -13,7 +13,7 @@ use rail_mbs::cosim::{
     TankFrameSample, TankMotionInput,
 };
 
-const G: f64 = 9.81;
+use ancf_core::constants::GRAVITY as G;
 const RHO: f64 = 998.0;
 // box of water: 0.4 × 0.3 × 0.1 m in a 0.4 × 0.3 × 0.25 m tank (free surface at z = 0.1)
 const L: [f64; 3] = [0.4, 0.3, 0.1];

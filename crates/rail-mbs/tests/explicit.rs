@@ -12,7 +12,7 @@ use rail_mbs::integrator::{BlockMass, Explicit, ExplicitParams};
 use rail_mbs::slosh::validate::{dominant_frequency, liquid};
 use rail_mbs::slosh::{PiecewiseAcceleration, PrescribedMotion, SloshFrame, SloshRun, SloshSystem};
 
-const G: f64 = 9.81;
+use ancf_core::constants::GRAVITY as G;
 const RHO: f64 = 998.0;
 // seed 003's rectangular tank: 0.416 × 0.324 m, water 0.132 m deep
 const L: [f64; 3] = [0.416, 0.324, 0.132];

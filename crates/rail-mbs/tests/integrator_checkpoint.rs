@@ -16,7 +16,7 @@ use rail_mbs::mbs::{JointKind, Multibody, RigidBody};
 use rail_mbs::slosh::validate::{liquid, slosh_params};
 use rail_mbs::slosh::{PiecewiseAcceleration, PrescribedMotion, SloshFrame, SloshSystem};
 
-const G: f64 = 9.81;
+use ancf_core::constants::GRAVITY as G;
 
 /// Water in a small box tank hit by a lateral pulse (2×3×2 elements).
 fn slosh_system() -> SloshSystem {

@@ -9,7 +9,7 @@
 //! same mean depth (width W laterally, length L longitudinally), the "equivalent rectangular
 //! tank" approximation:
 //!
-//! - ω² = (π g / B) tanh(π d / B), B = W or L (g = 9.81 m/s²);
+//! - ω² = (π g / B) tanh(π d / B), B = W or L (g = [`GRAVITY`]);
 //! - sloshing mass m_B = m · 8 B tanh(π d / B) / (π³ d) (potential flow, first mode);
 //! - pendulum length l = g / ω², hinged at l above z̄ so that each bob hangs at the liquid's
 //!   centre of mass (the static moment is exact; the dynamic moment arm is approximate);
@@ -99,7 +99,7 @@ impl LiquidSection {
     }
 
     /// First slosh mode of the equivalent rectangular tank of extent `span` along the
-    /// sloshing direction: (ω² at g = 9.81 m/s², sloshing mass).
+    /// sloshing direction: (ω² at g = [`GRAVITY`], sloshing mass).
     pub fn mode(&self, span: f64) -> (f64, f64) {
         let k = std::f64::consts::PI / span;
         let th = (k * self.mean_depth).tanh();

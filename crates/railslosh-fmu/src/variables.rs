@@ -11,7 +11,7 @@ pub const MODEL_IDENTIFIER: &str = "railslosh_slosh";
 /// the variables change.
 pub const INSTANTIATION_TOKEN: &str = "{5f0c3a52-7d1e-4b8a-9c6f-railslosh-slosh-v1}";
 /// Gravitational acceleration used by default and for the equivalent-pendulum frequencies (m/s²).
-pub const GRAVITY: f64 = 9.81;
+pub use ancf_core::constants::GRAVITY;
 
 /// Causality of a variable.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

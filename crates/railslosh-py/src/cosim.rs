@@ -188,7 +188,7 @@ struct PySloshParticipant {
 impl PySloshParticipant {
     #[new]
     #[pyo3(signature = (mesh, fluid, tank_shape, tank_dims, bulkheads=Vec::new(), h_max=0.005,
-                        reference_point=[0.0, 0.0, 0.0], gravity=9.81, t0=0.0, viscous_points=3, penalty_points=3))]
+                        reference_point=[0.0, 0.0, 0.0], gravity=ancf_core::constants::GRAVITY, t0=0.0, viscous_points=3, penalty_points=3))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -277,6 +277,12 @@ impl PySloshParticipant {
     }
 
     /// Current time (s).
+    /// Magnitude of gravity of the default input and the rest state, m/s².
+    #[getter]
+    fn gravity(&self) -> f64 {
+        self.inner.gravity()
+    }
+
     #[getter]
     fn time(&self) -> f64 {
         self.inner.time()
@@ -336,7 +342,7 @@ impl PySloshParticipant {
 /// `position`, `velocity`, `pose_acceleration`, `pose_angular_velocity`,
 /// `pose_angular_acceleration` (n×3), `rotation` (n×3×3).
 #[pyfunction]
-#[pyo3(signature = (dt=0.005, t_after=2.0, gravity=9.81, t_before=0.5))]
+#[pyo3(signature = (dt=0.005, t_after=2.0, gravity=ancf_core::constants::GRAVITY, t_before=0.5))]
 fn seed003_maneuvers<'py>(
     py: Python<'py>,
     dt: f64,

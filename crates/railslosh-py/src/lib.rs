@@ -441,7 +441,7 @@ impl PyFluidBody {
 /// that stopped the run; the arrays then hold everything computed before it) and `stats`.
 #[pyfunction]
 #[pyo3(signature = (mesh, fluid, tank_shape, tank_dims, bulkheads, acceleration, rotation_axis, angular_acceleration,
-                    t_end, h, frame="inertial", gravity=[0.0, 0.0, -9.81], viscous_points=3, penalty_points=3,
+                    t_end, h, frame="inertial", gravity=[0.0, 0.0, -ancf_core::constants::GRAVITY], viscous_points=3, penalty_points=3,
                     progress=None, volume_tolerance=0.01, penetration_limit=0.5, contact_stiffness_factor=1.0,
                     stream=None, checkpoint=None, checkpoint_every=100, resume_from=None,
                     contact_points_per_edge=3, contact_point_rule="gauss", stepper="implicit",
@@ -728,6 +728,11 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("RailsloshError", m.py().get_type::<RailsloshError>())?;
     m.add("WALL_DAMPING_RATIO", ancf_core::contact::WALL_DAMPING_RATIO)?;
+    m.add("GRAVITY", ancf_core::constants::GRAVITY)?;
+    m.add("FOOT", ancf_core::constants::FOOT)?;
+    m.add("INCH", ancf_core::constants::INCH)?;
+    m.add("MPH", ancf_core::constants::MPH)?;
+    m.add("ARC_DEGREE_RADIUS_FT", rail_mbs::track::ARC_DEGREE_RADIUS_FT)?;
     m.add_class::<PyFluidMesh>()?;
     m.add_class::<PyFluid>()?;
     m.add_class::<PyFluidBody>()?;

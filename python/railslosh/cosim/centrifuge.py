@@ -33,6 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from railslosh.constants import GRAVITY
 from railslosh.cosim import monolithic
 from railslosh.cosim.emulators import (
     CentrifugeArm,
@@ -128,7 +129,7 @@ class CentrifugeCase:
             d = monolithic.rhs(v, sl, 1.0, y)
             return [d[1], d[3]]
 
-        x = fsolve(f, [acc0 / self.spring_frequency**2, -math.atan2(acc0, 9.81)], xtol=1e-13)
+        x = fsolve(f, [acc0 / self.spring_frequency**2, -math.atan2(acc0, GRAVITY)], xtol=1e-13)
         return float(x[0]), float(x[1])
 
     def added_mass_ratio(self, mass_ratio: float, theta: float | None = None) -> float:

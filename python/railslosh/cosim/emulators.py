@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from railslosh.constants import GRAVITY
 from railslosh.cosim.protocol import (
     check_load,
     check_motion,
@@ -29,9 +30,6 @@ from railslosh.cosim.protocol import (
     motion_to_vector,
     vector_to_motion,
 )
-
-G0 = 9.81
-"""Nominal gravity, m/s² (docs/frames.md)."""
 
 
 def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -85,7 +83,7 @@ class SloshParameters:
         return self.fluid_mass - self.sloshing_mass
 
 
-def rectangular_modes(length: float, depth: float, n_modes: int = 1, g: float = G0) -> list[tuple[float, float]]:
+def rectangular_modes(length: float, depth: float, n_modes: int = 1, g: float = GRAVITY) -> list[tuple[float, float]]:
     """Antisymmetric sloshing modes of a rectangular tank, linear potential flow, per unit of
     liquid mass: list of (ω_n, m_n/M), n' = 2n - 1 (n = 1..n_modes).
 
@@ -106,7 +104,7 @@ def rectangular_modes(length: float, depth: float, n_modes: int = 1, g: float = 
 
 
 def rectangular_tank(
-    length: float, width: float, depth: float, *, direction: str = "y", density: float = 1000.0, g: float = G0
+    length: float, width: float, depth: float, *, direction: str = "y", density: float = 1000.0, g: float = GRAVITY
 ) -> SloshParameters:
     """Equivalent pendulum of a rectangular tank (liquid depth ``depth``, bottom at z = 0, centred
     in x and y), sloshing along ``direction`` ("x" or "y") whose tank dimension is ``length``.
@@ -229,7 +227,7 @@ def _steklov_lambda(fill: float, n: int) -> float:
 
 
 def horizontal_cylinder(
-    radius: float, length: float, fill: float, *, density: float = 1000.0, g: float = G0, lam: float | None = None
+    radius: float, length: float, fill: float, *, density: float = 1000.0, g: float = GRAVITY, lam: float | None = None
 ) -> SloshParameters:
     """Equivalent pendulum of a horizontal circular cylinder (axis x, centred on the tank origin,
     flat ends) for transverse (y) sloshing, filled to depth h = fill · 2R.
@@ -526,7 +524,7 @@ class TankOnSprings(RigidTankVehicle):
         damping: Sequence[float] | float = 0.0,
         *,
         axes: str = "y",
-        gravity: Sequence[float] = (0.0, 0.0, -G0),
+        gravity: Sequence[float] = (0.0, 0.0, -GRAVITY),
         external_force: Callable[[float], Sequence[float]] | None = None,
         q0: Sequence[float] | None = None,
         qd0: Sequence[float] | None = None,
@@ -601,7 +599,7 @@ class CentrifugeArm(RigidTankVehicle):
         spin_rate: float,
         *,
         spinup_angle: float = math.pi / 4,
-        g: float = G0,
+        g: float = GRAVITY,
         s0: float = 0.0,
         sd0: float = 0.0,
         max_step: float = 5e-3,

@@ -18,7 +18,7 @@ acceleration of the tank, plus the gravity direction) is a dict with four 3-vect
 ``angular_acceleration``
     angular acceleration of the tank, rad/s²;
 ``gravity``
-    the gravity vector, m/s² (``(0, 0, -9.81)`` for a level tank).
+    the gravity vector, m/s² (``(0, 0, -9.80665)`` for a level tank).
 
 A load is ``(force, moment)``: the force the fluid exerts **on the tank** and its moment about
 the tank origin, tank axes (docs/frames.md, "Signs of forces and loads").

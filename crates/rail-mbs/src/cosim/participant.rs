@@ -94,7 +94,7 @@ pub struct SloshParticipantConfig {
     /// given. Default the tank origin.
     pub reference_point: [f64; 3],
     /// Magnitude of gravity g (m/s², ≥ 0), used for pose inputs (gravity −g along global
-    /// z), the initial rest state and the default contact law. Default 9.81.
+    /// z), the initial rest state and the default contact law. Default [`ancf_core::constants::GRAVITY`].
     pub gravity: f64,
     /// Start time (s). Default 0.
     pub t0: f64,
@@ -112,7 +112,7 @@ impl SloshParticipantConfig {
             hht: slosh_params(),
             h_max: 0.005,
             reference_point: [0.0; 3],
-            gravity: 9.81,
+            gravity: ancf_core::constants::GRAVITY,
             t0: 0.0,
         }
     }

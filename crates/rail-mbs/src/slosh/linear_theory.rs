@@ -268,7 +268,7 @@ fn propagate([x0, v0]: [f64; 2], w: f64, zeta: f64, a0: f64, slope: f64, h: f64)
 mod tests {
     use super::*;
 
-    const G: f64 = 9.81;
+    use ancf_core::constants::GRAVITY as G;
     // seed 003's tank: 0.324 m along the excitation, 0.132 m water, 0.416 m long
     const L: f64 = 0.324;
     const H: f64 = 0.132;

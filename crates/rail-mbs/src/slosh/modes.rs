@@ -108,8 +108,9 @@ mod tests {
     use ancf_core::tank::{TankGeometry, TankShape};
 
     use super::*;
-    use crate::slosh::validate::{G, liquid};
+    use crate::slosh::validate::liquid;
     use crate::slosh::{PrescribedMotion, SloshFrame};
+    use ancf_core::constants::GRAVITY as G;
 
     #[test]
     fn modes_are_mass_normalized_and_effective_masses_sum_to_the_mass() {

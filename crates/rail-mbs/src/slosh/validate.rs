@@ -26,8 +26,7 @@ use ancf_core::validate::Record;
 use super::{PiecewiseAcceleration, PrescribedMotion, SloshFrame, SloshRecord, SloshRun, SloshSystem, linear_modes};
 use crate::integrator::{AdaptiveParams, HhtParams, StepControl};
 
-/// Gravity used by the validation cases (m/s²).
-pub const G: f64 = 9.81;
+use ancf_core::constants::GRAVITY as G;
 
 /// Names of the slosh cases.
 pub const CASES: [&str; 8] = [

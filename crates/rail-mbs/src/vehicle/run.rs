@@ -169,11 +169,8 @@ impl TrainRecord {
             self.steps = s.steps;
             self.rejected_steps = s.rejected_steps;
             self.jacobian_evaluations = s.jacobian_evaluations;
-            self.time_split = [
-                s.time_assembly.as_secs_f64(),
-                s.time_factorization.as_secs_f64(),
-                s.time_solve.as_secs_f64(),
-            ];
+            self.time_split =
+                [s.time_assembly.as_secs_f64(), s.time_factorization.as_secs_f64(), s.time_solve.as_secs_f64()];
         }
         self.wall_time = start.elapsed().as_secs_f64();
     }

@@ -1,0 +1,53 @@
+"""One definition of each physical constant (issue 18): the Python modules, the binding's defaults
+and the FMU use the Rust crate's standard gravity, and no library source carries another value."""
+
+from __future__ import annotations
+
+import inspect
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import railslosh as rs
+from railslosh import _core, constants, fluid_model, fluids, rail, stress
+from railslosh import fmu as rfmu
+from railslosh.cosim import emulators
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_every_module_uses_the_one_standard_gravity():
+    assert constants.GRAVITY == _core.GRAVITY == 9.80665
+    for g in (rail.GRAVITY, fluids.GRAVITY, rfmu.GRAVITY, stress.G, fluid_model.G, emulators.GRAVITY):
+        assert g == constants.GRAVITY
+    assert (constants.FOOT, constants.INCH, constants.MPH) == (0.3048, 0.0254, 0.44704)
+    assert inspect.signature(rs.slosh.run).parameters["gravity"].default == (0.0, 0.0, -constants.GRAVITY)
+
+
+def test_the_binding_defaults_are_the_standard_gravity():
+    """The co-simulation participant and the manoeuvre library default to the same g: the
+    participant at rest carries its weight at standard gravity, and the seed-003 manoeuvres give
+    gravity of that magnitude before they start."""
+    k = 1000 * 998 * constants.GRAVITY * 0.1
+    fluid = _core.Fluid(998.0, "newtonian", viscosity=0.05, bulk_penalty=k, bulk_damping=0.2 * np.sqrt(k * 998) * 0.05)
+    mesh = _core.box_mesh([-0.2, -0.15, 0.0], [0.4, 0.3, 0.1], [1, 1, 1])
+    p = _core.SloshParticipant(mesh, fluid, "box", [-0.2, -0.15, 0.0, 0.2, 0.15, 0.25])
+    assert p.gravity == constants.GRAVITY
+    man = _core.seed003_maneuvers(dt=0.01, t_after=0.1)[0]
+    assert np.linalg.norm(np.asarray(man["gravity"])[0]) == pytest.approx(constants.GRAVITY, rel=1e-15)
+
+
+def test_no_library_source_defines_another_gravity():
+    """9.81 (or 9.8) as a number in library code is a second, rounded gravity."""
+    pattern = re.compile(r"(?<![\d.])9\.81?(?![\d])")
+    offenders = []
+    for path in [*(ROOT / "python" / "railslosh").rglob("*.py"), *(ROOT / "crates").glob("*/src/**/*.rs")]:
+        text = path.read_text()
+        if path.suffix == ".rs" and "#[cfg(test)]" in text:
+            text = text.split("#[cfg(test)]")[0]  # unit-test systems may use any g
+        for n, line in enumerate(text.splitlines(), 1):
+            if pattern.search(line):
+                offenders.append(f"{path.relative_to(ROOT)}:{n}: {line.strip()}")
+    assert not offenders, "\n".join(offenders)
