@@ -85,7 +85,7 @@ from typing import Any
 import numpy as np
 
 from railslosh import rail, vehicle
-from railslosh.constants import GRAVITY
+from railslosh.constants import ARC_DEGREE_RADIUS_FT, FOOT, GRAVITY, INCH, MPH
 
 __all__ = [
     "OILS",
@@ -99,9 +99,6 @@ __all__ = [
     "scene_from_dict",
 ]
 
-FOOT = 0.3048
-INCH = 0.0254
-ARC_DEGREE_RADIUS_FT = 5729.577951308232
 PRESETS = ("table1", "tangent")
 """Names accepted by ``[track] preset``."""
 
@@ -856,7 +853,6 @@ def _merge(base: Mapping[str, Any], over: Mapping[str, Any]) -> dict[str, Any]:
 
 # --- prescribed-motion slosh scenes -------------------------------------------------------------
 
-MPH = 0.44704
 TANK_SHAPES = ("elliptic", "cylinder", "box")
 MANEUVERS = ("lane_change", "bump", "pulse", "samples")
 """Names accepted by ``[maneuver] type``."""
