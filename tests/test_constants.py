@@ -20,7 +20,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def test_every_module_uses_the_one_standard_gravity():
     assert constants.GRAVITY == _core.GRAVITY == 9.80665
-    for g in (rail.GRAVITY, fluids.GRAVITY, rfmu.GRAVITY, stress.G, fluid_model.G, emulators.GRAVITY):
+    for g in (rail.GRAVITY, rfmu.GRAVITY, stress.G, fluid_model.G, emulators.GRAVITY):
         assert g == constants.GRAVITY
     assert (constants.FOOT, constants.INCH, constants.MPH) == (0.3048, 0.0254, 0.44704)
     assert inspect.signature(rs.slosh.run).parameters["gravity"].default == (0.0, 0.0, -constants.GRAVITY)
@@ -64,3 +64,14 @@ def test_the_us_units_are_defined_once():
     pattern = re.compile(r"(?<![\d.])(0\.3048|0\.0254|0\.44704)(?![\d])")
     offenders = [o for o in _library_lines(pattern, "crates/ancf-core/src/constants.rs") if ">>>" not in o]
     assert not offenders, "\n".join(offenders)
+
+
+def test_the_liquids_and_penalty_rules_are_the_rust_defaults():
+    """One oil table and one penalty rule (``rail_mbs::defaults``) for Python fluids, scenes and vehicle runs."""
+    assert fluids.LIQUIDS == dict(_core.crude_oils())
+    assert fluids.CRUDE_OILS["light"] == (850.0, 0.005, 0.0) and "water" in fluids.LIQUIDS
+    light = fluids.crude_oil("light", depth=1.5)
+    assert light.bulk_penalty == _core.default_bulk_penalty(850.0, 1.5) == 850.0 * constants.GRAVITY * 1.5 / 1e-3
+    assert fluids.default_bulk_damping(2.0e6, 850.0, 0.5) == pytest.approx(0.2 * np.sqrt(2.0e6 * 850.0) * 0.5)
+    with pytest.raises(ValueError, match="element_height"):
+        _core.default_bulk_damping(2.0e6, 850.0, -1.0)

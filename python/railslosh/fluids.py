@@ -7,15 +7,14 @@ Penalty parameters (seed 000 §4.1): ``bulk_penalty`` k_IC is a bulk modulus (Pa
 
 from __future__ import annotations
 
+from railslosh import _core
 from railslosh._core import Fluid
-from railslosh.constants import GRAVITY
 
-#: Seed 000 Table 2: density (kg/m^3), dynamic viscosity (Pa s), yield stress (Pa).
-CRUDE_OILS: dict[str, tuple[float, float, float]] = {
-    "light": (850.0, 0.005, 0.0),
-    "medium": (900.0, 10.0, 30.0),
-    "heavy": (1000.0, 100.0, 100.0),
-}
+#: Seed 000 Table 2 and water: density (kg/m^3), dynamic viscosity (Pa s), yield stress (Pa)
+#: (``rail_mbs::defaults::Oil``, the table vehicle runs use).
+LIQUIDS: dict[str, tuple[float, float, float]] = dict(_core.crude_oils())
+#: The three crude oils of seed 000 Table 2.
+CRUDE_OILS: dict[str, tuple[float, float, float]] = {k: v for k, v in LIQUIDS.items() if k != "water"}
 
 
 def default_bulk_penalty(density: float, depth: float, strain: float = 1e-3) -> float:
@@ -26,12 +25,19 @@ def default_bulk_penalty(density: float, depth: float, strain: float = 1e-3) -> 
     (default strain 1e-3, so k = 1000 rho g H) keeps the mean volume error near
     0.05 %, while k stays 2-3 orders below the physical bulk modulus of oil (~1.5 GPa),
     which keeps the system far less stiff (the dilatational wave speed is sqrt(k/rho)).
+    The rule is ``rail_mbs::defaults::default_bulk_penalty``, the one vehicle runs use.
     """
     if not (density > 0 and depth > 0 and strain > 0):
         raise ValueError(
             f"invalid parameter `density`/`depth`/`strain` = {density}/{depth}/{strain}: allowed numbers > 0"
         )
-    return density * GRAVITY * depth / strain
+    return _core.default_bulk_penalty(density, depth, strain)
+
+
+def default_bulk_damping(bulk_penalty: float, density: float, element_height: float) -> float:
+    """Default penalty bulk viscosity c_TD = 0.2 sqrt(k_IC rho) h_el (Pa s) for elements
+    ``element_height`` m high (``rail_mbs::defaults::default_bulk_damping``)."""
+    return _core.default_bulk_damping(bulk_penalty, density, element_height)
 
 
 def _penalty(density: float, bulk_penalty: float | None, depth: float) -> float:
@@ -157,5 +163,6 @@ def crude_oil(kind: str, *, depth: float = 1.5, bulk_penalty: float | None = Non
 
 
 def water(*, depth: float = 1.5, bulk_penalty: float | None = None) -> Fluid:
-    """Water at 20 C: 998 kg/m^3, 1.0e-3 Pa s."""
-    return newtonian(998.0, 1.0e-3, depth=depth, bulk_penalty=bulk_penalty)
+    """Water at 20 C: 998 kg/m^3, 1.0e-3 Pa s (``LIQUIDS["water"]``)."""
+    rho, mu, _ = LIQUIDS["water"]
+    return newtonian(rho, mu, depth=depth, bulk_penalty=bulk_penalty)

@@ -271,7 +271,7 @@ class FluidSpec:
 
         rho = self.density()
         k = float(self.custom.get("bulk_penalty", fluids.default_bulk_penalty(rho, depth)))
-        c = 0.0 if element_height is None else 0.2 * math.sqrt(k * rho) * element_height
+        c = 0.0 if element_height is None else fluids.default_bulk_damping(k, rho, element_height)
         c = float(self.custom.get("bulk_damping", c))
         if self.oil == "custom":
             args = {key: v for key, v in self.custom.items() if key not in ("density", "model")}
@@ -284,7 +284,8 @@ class FluidSpec:
                     msg if msg.startswith("invalid parameter") else f"invalid parameter `fluid`: {msg}"
                 ) from exc
         if self.oil == "water":
-            return fluids.newtonian(998.0, 1.0e-3, bulk_penalty=k, bulk_damping=c)
+            _, mu, _ = fluids.LIQUIDS["water"]
+            return fluids.newtonian(rho, mu, bulk_penalty=k, bulk_damping=c)
         _, mu, tau0 = fluids.CRUDE_OILS[self.oil]
         return fluids.oldroyd(rho, mu, tau0, bulk_penalty=k, bulk_damping=c)
 
@@ -292,11 +293,9 @@ class FluidSpec:
         """Liquid density, kg/m^3."""
         if self.oil == "custom":
             return float(self.custom["density"])
-        if self.oil == "water":
-            return 998.0
         from railslosh import fluids
 
-        return fluids.CRUDE_OILS[self.oil][0]
+        return fluids.LIQUIDS[self.oil][0]
 
     def mass(self, params: Mapping[str, float]) -> float:
         """Liquid mass per car, kg (density times the exact liquid volume of the car's tank)."""
@@ -984,7 +983,9 @@ class SloshScene:
         depth = self.depth()
         spec = self.fluid
         if "bulk_penalty" not in spec.custom:
-            k = 1000.0 * spec.density() * GRAVITY * depth * max(1.0, self.peak_load_factor())
+            from railslosh import fluids
+
+            k = fluids.default_bulk_penalty(spec.density(), depth) * max(1.0, self.peak_load_factor())
             spec = dataclasses.replace(spec, custom={**spec.custom, "bulk_penalty": k})
         fluid = spec.make_fluid(depth, depth / spec.counts[2])
         kw: dict[str, Any] = {

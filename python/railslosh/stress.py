@@ -227,7 +227,7 @@ def _scenes_dir() -> Any:
 def _fluid(kw: dict[str, Any], depth: float):
     from railslosh import fluids
 
-    rho = 998.0
+    rho = fluids.LIQUIDS["water"][0]
     k = kw["penalty_factor"] * fluids.default_bulk_penalty(rho, depth)
     mu, tau, n = kw["viscosity"], kw["yield_stress"], kw["power_index"]
     if n != 1.0 or tau > 0.0:

@@ -19,7 +19,7 @@ use ancf_core::mesh::{EllipticCylinderSpec, elliptic_cylinder};
 use ancf_core::tank::{TankGeometry, TankShape};
 use rail_mbs::cosim::maneuvers::seed003_maneuvers;
 use rail_mbs::cosim::{SloshParticipant, SloshParticipantConfig, TankMotionInput};
-use rail_mbs::slosh::validate::liquid;
+use rail_mbs::defaults::liquid;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<(String, String)> = std::env::args()

@@ -18,10 +18,10 @@ use ancf_core::contact::{WallContact, WallContactLaw};
 use ancf_core::element::QuadratureOptions;
 use ancf_core::mesh::{CylinderTankSpec, box_mesh, cylinder_tank};
 use ancf_core::tank::{TankGeometry, TankShape};
+use rail_mbs::defaults::{Oil, liquid, slosh_params};
 use rail_mbs::integrator::ExplicitParams;
-use rail_mbs::slosh::validate::{dominant_frequency, liquid, slosh_params};
+use rail_mbs::slosh::validate::dominant_frequency;
 use rail_mbs::slosh::{PiecewiseAcceleration, PrescribedMotion, SloshFrame, SloshRecord, SloshRun, SloshSystem};
-use rail_mbs::vehicle::studies::Oil;
 
 use ancf_core::constants::GRAVITY as G;
 const L: [f64; 3] = [0.416, 0.324, 0.132];

@@ -16,8 +16,8 @@ use ancf_core::mesh::{CylinderTankSpec, box_mesh, cylinder_tank};
 use ancf_core::tank::{TankGeometry, TankShape};
 use faer::linalg::solvers::Solve;
 use faer::{Mat, Par, Side};
+use rail_mbs::defaults::{liquid, slosh_params};
 use rail_mbs::integrator::{HhtParams, MechanicalSystem};
-use rail_mbs::slosh::validate::{liquid, slosh_params};
 use rail_mbs::slosh::{PrescribedMotion, SloshFrame, SloshRun, SloshSystem};
 
 fn main() {

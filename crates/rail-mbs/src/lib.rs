@@ -13,6 +13,7 @@
 #![warn(missing_docs)]
 
 pub mod cosim;
+pub mod defaults;
 pub mod integrator;
 pub mod invariants;
 pub mod maneuvers;

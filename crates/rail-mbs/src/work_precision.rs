@@ -25,11 +25,13 @@ use ancf_core::error::{AncfError, Result};
 use ancf_core::mesh::box_mesh;
 use ancf_core::tank::{TankGeometry, TankShape};
 
+use crate::defaults::{Oil, SETTLE};
+use crate::defaults::{liquid, slosh_params};
 use crate::integrator::{IterativeParams, LinearSolverKind};
-use crate::slosh::validate::{dominant_frequency, liquid, rect_tank_frequency, slosh_params};
+use crate::slosh::validate::{dominant_frequency, rect_tank_frequency};
 use crate::slosh::{PiecewiseAcceleration, PrescribedMotion, SloshFrame, SloshRecord, SloshRun, SloshSystem};
 use crate::vehicle::BrakeScope;
-use crate::vehicle::studies::{BrakingCase, Oil, SETTLE, run_braking_with};
+use crate::vehicle::studies::{BrakingCase, run_braking_with};
 
 use ancf_core::constants::GRAVITY as G;
 

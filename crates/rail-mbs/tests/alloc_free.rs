@@ -15,9 +15,9 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::sync::Arc;
 
+use rail_mbs::defaults::Oil;
 use rail_mbs::integrator::{Hht, KktIndex, MechanicalSystem, SparsityPattern, Stats, SystemError};
 use rail_mbs::track::Track;
-use rail_mbs::vehicle::studies::Oil;
 use rail_mbs::vehicle::{FluidCargo, FluidVehicle, TankCarParams, TrainScenario, build_fluid_train, build_train};
 
 struct CountingAllocator;

@@ -8,8 +8,9 @@ use ancf_core::contact::{WallContact, WallContactLaw};
 use ancf_core::element::QuadratureOptions;
 use ancf_core::mesh::box_mesh;
 use ancf_core::tank::{TankGeometry, TankShape};
+use rail_mbs::defaults::liquid;
 use rail_mbs::integrator::{BlockMass, Explicit, ExplicitParams};
-use rail_mbs::slosh::validate::{dominant_frequency, liquid};
+use rail_mbs::slosh::validate::dominant_frequency;
 use rail_mbs::slosh::{PiecewiseAcceleration, PrescribedMotion, SloshFrame, SloshRun, SloshSystem};
 
 use ancf_core::constants::GRAVITY as G;
@@ -151,7 +152,7 @@ fn pulse_run(explicit: bool, t_end: f64) -> SloshRun {
     let mut run = if explicit {
         SloshRun::new_explicit(sys, 0.0, ExplicitParams::default()).unwrap()
     } else {
-        SloshRun::new(sys, 0.0, rail_mbs::slosh::validate::slosh_params()).unwrap()
+        SloshRun::new(sys, 0.0, rail_mbs::defaults::slosh_params()).unwrap()
     };
     run.run_to(t_end, 0.005).unwrap();
     run

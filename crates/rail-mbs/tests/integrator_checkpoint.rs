@@ -7,13 +7,13 @@ use ancf_core::mesh::box_mesh;
 use ancf_core::tank::{TankGeometry, TankShape};
 use ancf_core::{FluidBody, QuadratureOptions, Rheology};
 use nalgebra::{Matrix3, Vector3};
+use rail_mbs::defaults::{liquid, slosh_params};
 use rail_mbs::integrator::{
     AdaptiveParams, Checkpoint, CheckpointFile, FailureCause, Hht, HhtParams, IntegratorError, Journal,
     MechanicalSystem, Predictor, SparsityPattern, StepControl, SystemError, read_journal,
 };
 use rail_mbs::mbs::rotation::axis_angle;
 use rail_mbs::mbs::{JointKind, Multibody, RigidBody};
-use rail_mbs::slosh::validate::{liquid, slosh_params};
 use rail_mbs::slosh::{PiecewiseAcceleration, PrescribedMotion, SloshFrame, SloshSystem};
 
 use ancf_core::constants::GRAVITY as G;

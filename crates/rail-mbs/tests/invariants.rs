@@ -9,8 +9,8 @@ use ancf_core::element::QuadratureOptions;
 use ancf_core::mesh::box_mesh;
 use ancf_core::tank::{TankGeometry, TankShape};
 use rail_mbs::cosim::{CosimError, SloshParticipant, SloshParticipantConfig, TankFrameSample, TankMotionInput};
+use rail_mbs::defaults::{liquid, slosh_params};
 use rail_mbs::integrator::{FailureCause, IntegratorError, SystemError};
-use rail_mbs::slosh::validate::{liquid, slosh_params};
 use rail_mbs::slosh::{PiecewiseAcceleration, PrescribedMotion, SloshFrame, SloshRun, SloshSystem};
 
 use ancf_core::constants::GRAVITY as G;

@@ -253,8 +253,8 @@ fn unknowns_are_described_by_body_and_fluid_node() {
 /// Final state bits of a few steps of the studies' tank car (light crude, 6×4×2 mesh)
 /// inside a rayon pool of `threads` workers.
 fn fluid_car_in_pool(threads: usize) -> Vec<u64> {
+    use rail_mbs::defaults::Oil;
     use rail_mbs::track::Track;
-    use rail_mbs::vehicle::studies::Oil;
     use rail_mbs::vehicle::{FluidCargo, TankCarParams, TrainScenario, build_fluid_train};
     use std::sync::Arc;
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();

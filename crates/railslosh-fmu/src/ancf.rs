@@ -4,7 +4,7 @@
 //! The liquid is the structured mesh of a flat-ended elliptical cylinder
 //! ([`ancf_core::mesh::elliptic_cylinder`], `n_length × n_width × n_height` bricks), a
 //! Newtonian fluid with the default penalties of the slosh validation cases
-//! ([`rail_mbs::slosh::validate::liquid`]: k_IC = 1000 ρ g H, c_TD = 0.2 √(k_IC ρ) h_el), the
+//! ([`rail_mbs::defaults::liquid`]: k_IC = 1000 ρ g H, c_TD = 0.2 √(k_IC ρ) h_el), the
 //! default wall contact law for that depth, and the participant's HHT defaults (α = −0.3,
 //! adaptive steps ≤ `h_max`). Loads are those of the wall contact; they have no direct
 //! feedthrough from the inputs (the tank motion acts through the fluid's dynamics).
@@ -46,13 +46,9 @@ pub fn build(config: &ModelConfig, t0: f64) -> Result<Box<dyn FmuModel>, String>
     let h_el = (config.length / spec.n_length as f64)
         .min(2.0 * config.semi_axis_y / spec.n_width as f64)
         .min(depth / spec.n_height as f64);
-    let fluid = rail_mbs::slosh::validate::liquid(
-        config.density,
-        Rheology::Newtonian { viscosity: config.viscosity },
-        depth,
-        h_el,
-    )
-    .map_err(|e| e.to_string())?;
+    let fluid =
+        rail_mbs::defaults::liquid(config.density, Rheology::Newtonian { viscosity: config.viscosity }, depth, h_el)
+            .map_err(|e| e.to_string())?;
     let tank = TankGeometry::new(
         TankShape::EllipticCylinder {
             length: config.length,

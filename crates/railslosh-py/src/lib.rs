@@ -180,6 +180,33 @@ impl PyFluidMesh {
 }
 
 /// Box of fluid: origin (m), size (m) and element counts.
+/// The liquids of seed 000 Table 2 and water (`rail_mbs::defaults::Oil`): name ->
+/// (density kg/m³, dynamic viscosity Pa·s, yield stress Pa).
+#[pyfunction]
+fn crude_oils() -> Vec<(&'static str, (f64, f64, f64))> {
+    use rail_mbs::defaults::Oil;
+    [Oil::Light, Oil::Medium, Oil::Heavy, Oil::Water].iter().map(|o| (o.name(), o.properties())).collect()
+}
+
+/// Default penalty bulk modulus k_IC = ρ g H / strain, Pa (`rail_mbs::defaults::default_bulk_penalty`).
+#[pyfunction]
+#[pyo3(signature = (density, depth, strain=rail_mbs::defaults::PENALTY_STRAIN))]
+fn default_bulk_penalty(density: f64, depth: f64, strain: f64) -> PyResult<f64> {
+    rail_mbs::defaults::default_bulk_penalty(density, depth, strain).map_err(to_py)
+}
+
+/// Default penalty bulk viscosity c_TD = 0.2 √(k_IC ρ) h_el, Pa·s
+/// (`rail_mbs::defaults::default_bulk_damping`).
+#[pyfunction]
+fn default_bulk_damping(bulk_penalty: f64, density: f64, element_height: f64) -> PyResult<f64> {
+    for (field, value) in [("bulk_penalty", bulk_penalty), ("density", density), ("element_height", element_height)] {
+        if !(value.is_finite() && value >= 0.0) {
+            return Err(to_py(ancf_core::error::invalid(field, value, "a number >= 0")));
+        }
+    }
+    Ok(rail_mbs::defaults::default_bulk_damping(bulk_penalty, density, element_height))
+}
+
 #[pyfunction]
 fn box_mesh(py: Python<'_>, origin: [f64; 3], size: [f64; 3], counts: [usize; 3]) -> PyResult<PyFluidMesh> {
     compute(py, || mesh::box_mesh(origin, size, counts)).map(|inner| PyFluidMesh { inner })
@@ -564,7 +591,7 @@ fn run_slosh<'py>(
         let mut sys = SloshSystem::new(body, contact, motion, gravity, frame)?;
         sys.volume_tolerance = volume_tolerance;
         sys.penetration_limit *= penetration_limit / rail_mbs::slosh::system::PENETRATION_LIMIT_FACTOR;
-        let params = rail_mbs::slosh::validate::slosh_params();
+        let params = rail_mbs::defaults::slosh_params();
         let explicit = rail_mbs::integrator::ExplicitParams::default();
         let mut reason = String::from("requested: implicit");
         let mut run = match &resume_from {
@@ -736,6 +763,9 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyFluidMesh>()?;
     m.add_class::<PyFluid>()?;
     m.add_class::<PyFluidBody>()?;
+    m.add_function(wrap_pyfunction!(crude_oils, m)?)?;
+    m.add_function(wrap_pyfunction!(default_bulk_penalty, m)?)?;
+    m.add_function(wrap_pyfunction!(default_bulk_damping, m)?)?;
     m.add_function(wrap_pyfunction!(box_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(cylinder_tank, m)?)?;
     m.add_function(wrap_pyfunction!(elliptic_cylinder, m)?)?;

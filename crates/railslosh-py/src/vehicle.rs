@@ -7,10 +7,10 @@ use ancf_core::error::{AncfError, invalid};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use rail_mbs::defaults::{Oil, brake_torque};
 use rail_mbs::mbs::{SpeedProfile, Table};
 use rail_mbs::profile::aar1b_wheel_approx;
 use rail_mbs::track::{Track, TrackPoint};
-use rail_mbs::vehicle::studies::{Oil, brake_torque};
 use rail_mbs::vehicle::{
     BrakeScope, EquivalentCargo, EquivalentModel, EquivalentTrainRecord, FluidCargo, FluidTrainRecord, LoadFilter,
     Observer, SampleSink, SloshAxis, TankCarParams, TrainRecord, TrainScenario,
@@ -309,7 +309,7 @@ fn fluid_record_dict<'py>(py: Python<'py>, r: &FluidTrainRecord) -> PyResult<Bou
 
 /// Brake torque table `(times, torques)` per wheelset that slows a car of total mass
 /// `mass` (kg) from `v0` to `v1` (m/s) in `duration` s (seed 000 §8.2 design, see
-/// `rail_mbs::vehicle::studies::brake_torque`).
+/// `rail_mbs::defaults::brake_torque`).
 #[pyfunction]
 #[pyo3(signature = (mass, v0=40.0 / 3.6, v1=5.0 / 3.6, duration=10.0))]
 pub fn design_brake_torque(mass: f64, v0: f64, v1: f64, duration: f64) -> PyResult<(Vec<f64>, Vec<f64>)> {

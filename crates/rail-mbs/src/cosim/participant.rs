@@ -10,9 +10,9 @@ use ancf_core::mesh::FluidMesh;
 use ancf_core::tank::TankGeometry;
 use nalgebra::{Matrix3, Vector3};
 
+use crate::defaults::slosh_params;
 use crate::integrator::{Checkpoint, Hht, HhtParams, IntegratorError, Stats};
 use crate::invariants::{InvariantMonitor, Margins};
-use crate::slosh::validate::slosh_params;
 use crate::slosh::{PrescribedMotion, SloshFrame, SloshSystem, TankFrameInput, TankFrameSample};
 
 /// Errors of the co-simulation participant.

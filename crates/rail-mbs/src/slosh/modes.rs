@@ -108,7 +108,7 @@ mod tests {
     use ancf_core::tank::{TankGeometry, TankShape};
 
     use super::*;
-    use crate::slosh::validate::liquid;
+    use crate::defaults::liquid;
     use crate::slosh::{PrescribedMotion, SloshFrame};
     use ancf_core::constants::GRAVITY as G;
 

@@ -24,7 +24,6 @@ use ancf_core::tank::{Bulkhead, TankGeometry, TankShape};
 use ancf_core::validate::Record;
 
 use super::{PiecewiseAcceleration, PrescribedMotion, SloshFrame, SloshRecord, SloshRun, SloshSystem, linear_modes};
-use crate::integrator::{AdaptiveParams, HhtParams, StepControl};
 
 use ancf_core::constants::GRAVITY as G;
 
@@ -55,31 +54,7 @@ pub fn run_case(name: &str, quick: bool) -> Result<Vec<Record>> {
     }
 }
 
-/// Integrator settings used for sloshing: α = −0.3 (damps the penalty's high-frequency
-/// modes), tolerances scaled to accelerations of order g, adaptive steps (h is the
-/// largest step; it is halved where Newton fails or an element would invert, and grows
-/// back after 5 steps that converged in fewer than 5 iterations), and the Jacobian reused
-/// until the Newton contraction rate exceeds 0.5 (measured fastest on the tank-car
-/// benchmark: 10.0 s vs 17.5 s wall for 1 s simulated, `cargo bench -p rail-mbs --bench slosh`).
-pub fn slosh_params() -> HhtParams {
-    HhtParams {
-        alpha: -0.3,
-        abs_tol_acc: 1e-3,
-        max_iterations: 10,
-        refresh_rate: 0.5,
-        step_control: StepControl::Adaptive(AdaptiveParams { h_min: 1e-6, easy_iterations: 5, ..Default::default() }),
-        ..Default::default()
-    }
-}
-
-/// A fluid with the default penalties for liquid depth `depth` and mesh size `h_el`:
-/// k_IC = 1000 ρ g H, c_TD = 0.2 √(k_IC ρ) h_el.
-pub fn liquid(density: f64, rheology: Rheology, depth: f64, h_el: f64) -> Result<Fluid> {
-    let k = 1000.0 * density * G * depth;
-    let mut f = Fluid::new(density, rheology, k)?;
-    f.bulk_damping = 0.2 * (k * density).sqrt() * h_el;
-    Ok(f)
-}
+pub use crate::defaults::{liquid, slosh_params};
 
 #[allow(clippy::too_many_arguments)]
 fn run(

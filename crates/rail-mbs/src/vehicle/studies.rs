@@ -30,7 +30,6 @@
 
 use std::sync::Arc;
 
-use ancf_core::constitutive::{Fluid, Rheology};
 use ancf_core::element::QuadratureOptions;
 use ancf_core::error::{AncfError, Result, invalid};
 use ancf_core::validate::Record;
@@ -39,67 +38,10 @@ use super::equivalent::cylinder_lambda;
 use super::fluid::{FluidCargo, FluidTrainRecord, run_fluid_train};
 use super::run::{BrakeScope, TrainScenario};
 use super::tank_car::TankCarParams;
-use crate::mbs::{SpeedProfile, Table};
+use crate::mbs::SpeedProfile;
 use crate::track::{FOOT, GRAVITY, Track, TrackPoint};
 
-/// The liquids of the studies.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Oil {
-    /// Light crude: 850 kg/m³, 0.005 Pa·s, no yield stress (seed 000 Table 2).
-    Light,
-    /// Medium crude: 900 kg/m³, 10 Pa·s, 30 Pa.
-    Medium,
-    /// Heavy crude: 1000 kg/m³, 100 Pa·s, 100 Pa.
-    Heavy,
-    /// Water at 20 °C: 998 kg/m³, 1e-3 Pa·s.
-    Water,
-}
-
-impl Oil {
-    /// Density, viscosity, yield stress.
-    pub fn properties(self) -> (f64, f64, f64) {
-        match self {
-            Oil::Light => (850.0, 0.005, 0.0),
-            Oil::Medium => (900.0, 10.0, 30.0),
-            Oil::Heavy => (1000.0, 100.0, 100.0),
-            Oil::Water => (998.0, 1e-3, 0.0),
-        }
-    }
-
-    /// Name.
-    pub fn name(self) -> &'static str {
-        match self {
-            Oil::Light => "light",
-            Oil::Medium => "medium",
-            Oil::Heavy => "heavy",
-            Oil::Water => "water",
-        }
-    }
-
-    /// The oil of a name: `light`, `medium`, `heavy` or `water`.
-    pub fn from_name(name: &str) -> Result<Self> {
-        match name {
-            "light" => Ok(Oil::Light),
-            "medium" => Ok(Oil::Medium),
-            "heavy" => Ok(Oil::Heavy),
-            "water" => Ok(Oil::Water),
-            other => Err(invalid("oil", other, "'light', 'medium', 'heavy' or 'water'")),
-        }
-    }
-
-    /// The fluid with default penalties for a liquid depth and element height.
-    pub fn fluid(self, depth: f64, h_el: f64) -> Result<Fluid> {
-        let (rho, mu, tau) = self.properties();
-        let rheology = match self {
-            Oil::Water => Rheology::Newtonian { viscosity: mu },
-            _ => Rheology::Oldroyd { viscosity: mu, yield_stress: tau, elastic_modulus: None },
-        };
-        let k = 1000.0 * rho * GRAVITY * depth;
-        let mut f = Fluid::new(rho, rheology, k)?;
-        f.bulk_damping = 0.2 * (k * rho).sqrt() * h_el;
-        Ok(f)
-    }
-}
+pub use crate::defaults::{Oil, SETTLE, brake_torque};
 
 /// A braking run of the studies.
 #[derive(Debug, Clone)]
@@ -122,26 +64,6 @@ pub struct BrakingCase {
     /// the library default [`ancf_core::contact::WALL_DAMPING_RATIO`], or 1 as the shipped ECP
     /// scenes use).
     pub wall_damping_ratio: f64,
-}
-
-/// Settling time before the brakes apply, s.
-pub const SETTLE: f64 = 0.5;
-
-/// Brake torque per wheelset `T₀(1 − e^{−(t−t_s)/τ})` that slows a car of total mass
-/// `mass` from `v0` to `v1` in `duration` (rigid estimate, spin inertia included).
-pub fn brake_torque(p: &TankCarParams, mass: f64, v0: f64, v1: f64, duration: f64) -> Result<Table> {
-    let tau: f64 = 0.5;
-    let m_eq = mass + 4.0 * p.wheelset.inertia[1] / (p.wheel_radius * p.wheel_radius);
-    let eff = duration - tau * (1.0 - (-duration / tau).exp());
-    let t0 = (v0 - v1) * p.wheel_radius * m_eq / (4.0 * eff);
-    let ts: Vec<f64> = (0..=60).map(|i| SETTLE + 0.1 * i as f64).collect();
-    let mut x = vec![0.0];
-    let mut y = vec![0.0];
-    for t in ts {
-        x.push(t);
-        y.push(t0 * (1.0 - (-(t - SETTLE) / tau).exp()));
-    }
-    Table::new("brake torque", x, y)
 }
 
 fn tangent() -> Result<Arc<Track>> {

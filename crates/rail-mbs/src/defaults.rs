@@ -1,0 +1,170 @@
+//! Production defaults, one home for each (issue 18): the integrator settings of slosh runs,
+//! the penalty rules of the fluid, the crude oils of seed 000, and the brake design of the braking
+//! runs. Runs, the co-simulation participant, the FMU, the Python binding and the validation
+//! cases all take them from here; physical constants live in [`ancf_core::constants`].
+
+use ancf_core::constitutive::{Fluid, Rheology};
+use ancf_core::error::{Result, invalid};
+
+pub use ancf_core::constants::GRAVITY;
+
+use crate::integrator::{AdaptiveParams, HhtParams, StepControl};
+use crate::mbs::Table;
+use crate::vehicle::TankCarParams;
+
+/// HHT settings of slosh runs: α = −0.3 (numerical damping of the penalty and contact
+/// modes), tolerances scaled to accelerations of order g, adaptive steps (h is the
+/// largest step; it is halved where Newton fails or an element would invert, and grows
+/// back after 5 steps that converged in fewer than 5 iterations), and the Jacobian reused
+/// until the Newton contraction rate exceeds 0.5 (measured fastest on the tank-car
+/// benchmark: 10.0 s vs 17.5 s wall for 1 s simulated, `cargo bench -p rail-mbs --bench slosh`).
+pub fn slosh_params() -> HhtParams {
+    HhtParams {
+        alpha: -0.3,
+        abs_tol_acc: 1e-3,
+        max_iterations: 10,
+        refresh_rate: 0.5,
+        step_control: StepControl::Adaptive(AdaptiveParams { h_min: 1e-6, easy_iterations: 5, ..Default::default() }),
+        ..Default::default()
+    }
+}
+
+/// Hydrostatic volume strain the default penalty bulk modulus allows: k_IC = ρ g H / strain.
+pub const PENALTY_STRAIN: f64 = 1e-3;
+
+/// Default penalty bulk modulus k_IC (Pa) of a liquid `depth` m deep: the hydrostatic pressure
+/// at the bottom, ρ g H, compresses it by `strain` (default [`PENALTY_STRAIN`]: k_IC = 1000 ρ g H,
+/// two to three orders below the physical bulk modulus of oil, which keeps the system far less
+/// stiff; docs/benchmarks.md shows the softer choices lose accuracy).
+pub fn default_bulk_penalty(density: f64, depth: f64, strain: f64) -> Result<f64> {
+    for (field, value) in [("density", density), ("depth", depth), ("strain", strain)] {
+        if !(value.is_finite() && value > 0.0) {
+            return Err(invalid(field, value, "a number > 0"));
+        }
+    }
+    Ok(density * GRAVITY * depth / strain)
+}
+
+/// Default penalty bulk viscosity c_TD = 0.2 √(k_IC ρ) h_el (Pa·s) for elements `h_el` m high.
+pub fn default_bulk_damping(bulk_penalty: f64, density: f64, h_el: f64) -> f64 {
+    0.2 * (bulk_penalty * density).sqrt() * h_el
+}
+
+/// A fluid with the default penalties for liquid depth `depth` and element height `h_el`:
+/// [`default_bulk_penalty`] and [`default_bulk_damping`].
+pub fn liquid(density: f64, rheology: Rheology, depth: f64, h_el: f64) -> Result<Fluid> {
+    let k = default_bulk_penalty(density, depth, PENALTY_STRAIN)?;
+    let mut f = Fluid::new(density, rheology, k)?;
+    f.bulk_damping = default_bulk_damping(k, density, h_el);
+    Ok(f)
+}
+
+/// The liquids of seed 000 Table 2 (and water), by name in scenes and the Python API.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Oil {
+    /// Light crude: 850 kg/m³, 0.005 Pa·s, no yield stress (seed 000 Table 2).
+    Light,
+    /// Medium crude: 900 kg/m³, 10 Pa·s, 30 Pa.
+    Medium,
+    /// Heavy crude: 1000 kg/m³, 100 Pa·s, 100 Pa.
+    Heavy,
+    /// Water at 20 °C: 998 kg/m³, 1e-3 Pa·s.
+    Water,
+}
+
+impl Oil {
+    /// Density, viscosity, yield stress.
+    pub fn properties(self) -> (f64, f64, f64) {
+        match self {
+            Oil::Light => (850.0, 0.005, 0.0),
+            Oil::Medium => (900.0, 10.0, 30.0),
+            Oil::Heavy => (1000.0, 100.0, 100.0),
+            Oil::Water => (998.0, 1e-3, 0.0),
+        }
+    }
+
+    /// Name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Oil::Light => "light",
+            Oil::Medium => "medium",
+            Oil::Heavy => "heavy",
+            Oil::Water => "water",
+        }
+    }
+
+    /// The oil of a name: `light`, `medium`, `heavy` or `water`.
+    pub fn from_name(name: &str) -> Result<Self> {
+        match name {
+            "light" => Ok(Oil::Light),
+            "medium" => Ok(Oil::Medium),
+            "heavy" => Ok(Oil::Heavy),
+            "water" => Ok(Oil::Water),
+            other => Err(invalid("oil", other, "'light', 'medium', 'heavy' or 'water'")),
+        }
+    }
+
+    /// The fluid with the default penalties ([`liquid`]) for a liquid depth and element height.
+    pub fn fluid(self, depth: f64, h_el: f64) -> Result<Fluid> {
+        let (rho, mu, tau) = self.properties();
+        let rheology = match self {
+            Oil::Water => Rheology::Newtonian { viscosity: mu },
+            _ => Rheology::Oldroyd { viscosity: mu, yield_stress: tau, elastic_modulus: None },
+        };
+        liquid(rho, rheology, depth, h_el)
+    }
+}
+
+/// Settling time before the brakes apply, s.
+pub const SETTLE: f64 = 0.5;
+
+/// Brake torque per wheelset `T₀(1 − e^{−(t−t_s)/τ})` that slows a car of total mass
+/// `mass` from `v0` to `v1` in `duration` (rigid estimate, spin inertia included).
+pub fn brake_torque(p: &TankCarParams, mass: f64, v0: f64, v1: f64, duration: f64) -> Result<Table> {
+    let tau: f64 = 0.5;
+    let m_eq = mass + 4.0 * p.wheelset.inertia[1] / (p.wheel_radius * p.wheel_radius);
+    let eff = duration - tau * (1.0 - (-duration / tau).exp());
+    let t0 = (v0 - v1) * p.wheel_radius * m_eq / (4.0 * eff);
+    let ts: Vec<f64> = (0..=60).map(|i| SETTLE + 0.1 * i as f64).collect();
+    let mut x = vec![0.0];
+    let mut y = vec![0.0];
+    for t in ts {
+        x.push(t);
+        y.push(t0 * (1.0 - (-(t - SETTLE) / tau).exp()));
+    }
+    Table::new("brake torque", x, y)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_penalty_rule_allows_the_stated_hydrostatic_strain() {
+        // ρ g H / k_IC is the volume strain at the bottom of the liquid
+        let (rho, depth) = (850.0, 1.5);
+        let k = default_bulk_penalty(rho, depth, PENALTY_STRAIN).unwrap();
+        assert!((rho * GRAVITY * depth / k - PENALTY_STRAIN).abs() < 1e-18);
+        let f = liquid(rho, Rheology::Newtonian { viscosity: 0.005 }, depth, 0.75).unwrap();
+        assert_eq!(f.bulk_penalty, k);
+        assert_eq!(f.bulk_damping, 0.2 * (k * rho).sqrt() * 0.75);
+        let e = default_bulk_penalty(rho, 0.0, PENALTY_STRAIN).unwrap_err().to_string();
+        assert!(e.contains("depth"), "{e}");
+    }
+
+    #[test]
+    fn an_oil_is_its_table_row_with_the_default_penalties() {
+        for oil in [Oil::Light, Oil::Medium, Oil::Heavy, Oil::Water] {
+            let (rho, mu, tau) = oil.properties();
+            let f = oil.fluid(1.5, 0.75).unwrap();
+            let rheology = if oil == Oil::Water {
+                Rheology::Newtonian { viscosity: mu }
+            } else {
+                Rheology::Oldroyd { viscosity: mu, yield_stress: tau, elastic_modulus: None }
+            };
+            assert_eq!(f, liquid(rho, rheology, 1.5, 0.75).unwrap());
+            assert_eq!(Oil::from_name(oil.name()).unwrap(), oil);
+        }
+        assert!(Oil::from_name("olive").unwrap_err().to_string().contains("oil"));
+    }
+}
