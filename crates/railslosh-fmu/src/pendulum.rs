@@ -5,19 +5,23 @@
 //! ## Parameters from the geometry
 //! The liquid section below the free surface z_s (from the fill) has area A, free-surface
 //! width W and mean depth d = A/W; its centre of mass is at height
-//! z̄ = −(a/b)(2/3)(b² − z_s²)^{3/2} / A. Each mode is that of the rectangular tank of the
-//! same mean depth (width W laterally, length L longitudinally), the "equivalent rectangular
-//! tank" approximation:
+//! z̄ = −(a/b)(2/3)(b² − z_s²)^{3/2} / A. The modes come from the vehicle's equivalent model
+//! (`rail_mbs::vehicle::equivalent`), the one implementation of these rules:
 //!
-//! - ω² = (π g / B) tanh(π d / B), B = W or L (g = [`GRAVITY`]);
-//! - sloshing mass m_B = m · 8 B tanh(π d / B) / (π³ d) (potential flow, first mode);
-//! - pendulum length l = g / ω², hinged at l above z̄ so that each bob hangs at the liquid's
-//!   centre of mass (the static moment is exact; the dynamic moment arm is approximate);
+//! - longitudinal: the first mode of the rectangular tank of length L and depth d
+//!   (`rectangular_mode`): ω² = (π g / L) tanh(π d / L), m_L = m · 8 L tanh(π d / L) / (π³ d);
+//! - lateral, circular section (a = b = R, liquid depth 1–95 % of the diameter): the
+//!   transverse eigenvalue λ(h/2R) of the horizontal cylinder (`cylinder_lambda`, the Steklov
+//!   table) and `cylinder_lateral_mode`: ω² = λ g / R, m_W = m d̄ λ / R (d̄ = −z̄);
+//! - lateral, elliptical section (a ≠ b), or a circle outside that depth range: the
+//!   "equivalent rectangular tank" of width W and depth d, the rule above with L → W (no
+//!   eigenvalue table exists for the ellipse; for the half-full circle this rule gives
+//!   λ = 1.325 against the exact 1.3557, 2.3 % low);
+//! - g = [`GRAVITY`]; pendulum length l = g / ω², hinged at l above z̄ so that each bob hangs
+//!   at the liquid's centre of mass (the static moment is exact; the dynamic moment arm is
+//!   approximate; for the circle l = R/λ as in the vehicle model);
 //! - the rigid mass m₀ = m − m_L − m_W sits at the centre of mass. Where m_L + m_W would
 //!   exceed 0.9 m (shallow fills) both are scaled down to 0.9 m.
-//!
-//! For the half-full circular cylinder the lateral frequency is ω² = 1.325 g/R, 2.3 % below
-//! the exact 1.3557 g/R.
 //!
 //! ## Dynamics
 //! A bob of mass m at r(θ) = P + l u(θ), u = sin θ ê − cos θ ẑ (ê = x̂ or ŷ), tangent
@@ -33,27 +37,13 @@
 //! Time integration: classical Runge–Kutta 4 with steps ≤ `h_max`.
 
 use ancf_core::mesh::circle_segment_area;
+use nalgebra::Vector3;
+use rail_mbs::vehicle::equivalent::{DEPTH_FRACTION_RANGE, cylinder_lambda, cylinder_lateral_mode, rectangular_mode};
 
 use crate::model::{FmuModel, ModelConfig, Outputs, TankInput};
 use crate::variables::GRAVITY;
 
-type V3 = [f64; 3];
-
-fn add(a: V3, b: V3) -> V3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn scale(s: f64, a: V3) -> V3 {
-    [s * a[0], s * a[1], s * a[2]]
-}
-fn dot(a: V3, b: V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn cross(a: V3, b: V3) -> V3 {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
+type V3 = Vector3<f64>;
 
 /// Geometry and modal data of the liquid, derived from the configuration.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -99,13 +89,25 @@ impl LiquidSection {
     }
 
     /// First slosh mode of the equivalent rectangular tank of extent `span` along the
-    /// sloshing direction: (ω² at g = [`GRAVITY`], sloshing mass).
-    pub fn mode(&self, span: f64) -> (f64, f64) {
-        let k = std::f64::consts::PI / span;
-        let th = (k * self.mean_depth).tanh();
-        let omega2 = GRAVITY * k * th;
-        let m = self.mass * 8.0 * span * th / (std::f64::consts::PI.powi(3) * self.mean_depth);
-        (omega2, m)
+    /// sloshing direction (`rail_mbs::vehicle::equivalent::rectangular_mode`): (ω² at
+    /// g = [`GRAVITY`], sloshing mass).
+    pub fn mode(&self, span: f64) -> Result<(f64, f64), String> {
+        let (omega, m) = rectangular_mode(span, self.mean_depth, self.mass, GRAVITY).map_err(|e| e.to_string())?;
+        Ok((omega * omega, m))
+    }
+
+    /// First lateral mode (module docs): the horizontal cylinder's eigenvalue for a circular
+    /// section of radius `a` = `b` within the table's depth range, else the equivalent
+    /// rectangular tank of width W. (ω², sloshing mass).
+    pub fn lateral_mode(&self, a: f64, b: f64) -> Result<(f64, f64), String> {
+        let fraction = (self.z_surface + b) / (2.0 * b);
+        let (lo, hi) = DEPTH_FRACTION_RANGE;
+        if (a - b).abs() <= 1e-12 * b && (lo..=hi).contains(&fraction) {
+            let lam = cylinder_lambda(fraction).map_err(|e| e.to_string())?;
+            let (omega, m) = cylinder_lateral_mode(b, lam, self.mass, -self.z_com, GRAVITY);
+            return Ok((omega * omega, m));
+        }
+        self.mode(self.width)
     }
 }
 
@@ -126,37 +128,32 @@ struct Bob {
 
 impl Bob {
     fn unit(&self, th: f64) -> (V3, V3) {
-        let z = [0.0, 0.0, 1.0];
-        let u = sub(scale(th.sin(), self.dir), scale(th.cos(), z));
-        let t = add(scale(th.cos(), self.dir), scale(th.sin(), z));
-        (u, t)
+        let z = V3::z();
+        (th.sin() * self.dir - th.cos() * z, th.cos() * self.dir + th.sin() * z)
     }
 
     /// Position, relative velocity and the non-relative part of the inertial acceleration.
     fn kinematics(&self, th: f64, thd: f64, inp: &TankInput) -> (V3, V3, V3, V3, V3) {
         let (u, t) = self.unit(th);
-        let r = add(self.pivot, scale(self.length, u));
-        let rd = scale(self.length * thd, t);
-        let w = inp.angular_velocity;
-        let a_frame = add(
-            add(inp.acceleration, cross(inp.angular_acceleration, r)),
-            add(cross(w, cross(w, r)), scale(2.0, cross(w, rd))),
-        );
+        let r = self.pivot + self.length * u;
+        let rd = (self.length * thd) * t;
+        let (w, alpha) = (V3::from(inp.angular_velocity), V3::from(inp.angular_acceleration));
+        let a_frame = V3::from(inp.acceleration) + alpha.cross(&r) + w.cross(&w.cross(&r)) + 2.0 * w.cross(&rd);
         (r, rd, a_frame, u, t)
     }
 
     /// Angular acceleration θ̈.
     fn accel(&self, th: f64, thd: f64, inp: &TankInput, zeta: f64) -> f64 {
         let (_, _, a_frame, _, t) = self.kinematics(th, thd, inp);
-        dot(sub(inp.gravity, a_frame), t) / self.length - 2.0 * zeta * self.omega_n * thd
+        (V3::from(inp.gravity) - a_frame).dot(&t) / self.length - 2.0 * zeta * self.omega_n * thd
     }
 
     /// Position and force on the tank.
     fn load(&self, th: f64, thd: f64, inp: &TankInput, zeta: f64) -> (V3, V3) {
         let (r, _, a_frame, u, t) = self.kinematics(th, thd, inp);
         let thdd = self.accel(th, thd, inp, zeta);
-        let rdd = sub(scale(self.length * thdd, t), scale(self.length * thd * thd, u));
-        (r, scale(self.mass, sub(inp.gravity, add(a_frame, rdd))))
+        let rdd = (self.length * thdd) * t - (self.length * thd * thd) * u;
+        (r, self.mass * (V3::from(inp.gravity) - (a_frame + rdd)))
     }
 }
 
@@ -180,26 +177,26 @@ impl Pendulum {
     pub fn new(config: &ModelConfig, t0: f64) -> Result<Self, String> {
         config.validate()?;
         let s = LiquidSection::new(config);
-        let (w2_long, mut m_long) = s.mode(config.length);
-        let (w2_lat, mut m_lat) = s.mode(s.width);
+        let (w2_long, mut m_long) = s.mode(config.length)?;
+        let (w2_lat, mut m_lat) = s.lateral_mode(config.semi_axis_y, config.semi_axis_z)?;
         let cap = 0.9 * s.mass;
         if m_long + m_lat > cap {
             let f = cap / (m_long + m_lat);
             m_long *= f;
             m_lat *= f;
         }
-        let com0 = [0.0, 0.0, s.z_com];
+        let com0 = V3::new(0.0, 0.0, s.z_com);
         let bob = |dir: V3, w2: f64, m: f64| {
             let l = GRAVITY / w2;
-            Bob { dir, pivot: [0.0, 0.0, s.z_com + l], length: l, mass: m, omega_n: w2.sqrt() }
+            Bob { dir, pivot: V3::new(0.0, 0.0, s.z_com + l), length: l, mass: m, omega_n: w2.sqrt() }
         };
         Ok(Self {
             section: s,
             rigid_mass: s.mass - m_long - m_lat,
             com0,
-            bobs: [bob([1.0, 0.0, 0.0], w2_long, m_long), bob([0.0, 1.0, 0.0], w2_lat, m_lat)],
+            bobs: [bob(V3::x(), w2_long, m_long), bob(V3::y(), w2_lat, m_lat)],
             zeta: config.damping_ratio,
-            reference: config.reference,
+            reference: V3::from(config.reference),
             h_max: config.h_max,
             t: t0,
             y: [0.0; 4],
@@ -260,22 +257,21 @@ impl FmuModel for Pendulum {
     }
 
     fn outputs(&self, u: &TankInput) -> Outputs {
-        let mut out = Outputs::default();
+        let (mut force, mut moment, mut com) = (V3::zeros(), V3::zeros(), V3::zeros());
         let mut add_mass = |r: V3, f: V3, m: f64| {
-            out.force = add(out.force, f);
-            out.moment = add(out.moment, cross(sub(r, self.reference), f));
-            out.com = add(out.com, scale(m, r));
+            force += f;
+            moment += (r - self.reference).cross(&f);
+            com += m * r;
         };
-        let w = u.angular_velocity;
+        let (w, alpha) = (V3::from(u.angular_velocity), V3::from(u.angular_acceleration));
         let r0 = self.com0;
-        let a0 = add(add(u.acceleration, cross(u.angular_acceleration, r0)), cross(w, cross(w, r0)));
-        add_mass(r0, scale(self.rigid_mass, sub(u.gravity, a0)), self.rigid_mass);
+        let a0 = V3::from(u.acceleration) + alpha.cross(&r0) + w.cross(&w.cross(&r0));
+        add_mass(r0, self.rigid_mass * (V3::from(u.gravity) - a0), self.rigid_mass);
         for (k, bob) in self.bobs.iter().enumerate() {
             let (r, f) = bob.load(self.y[2 * k], self.y[2 * k + 1], u, self.zeta);
             add_mass(r, f, bob.mass);
         }
-        out.com = scale(1.0 / self.section.mass, out.com);
-        out
+        Outputs { force: force.into(), moment: moment.into(), com: (com / self.section.mass).into() }
     }
 
     fn mass(&self) -> f64 {
@@ -332,12 +328,32 @@ mod tests {
         // centroid of a half disc: 4R/(3π) below the diameter
         assert!((s.z_com + 4.0 * r / (3.0 * std::f64::consts::PI)).abs() < 1e-12);
         assert!((s.mass - 1000.0 * 0.5 * std::f64::consts::PI * r * r * 2.0).abs() < 1e-9);
-        // equivalent rectangular tank: ω²R/g = (π/2) tanh(π²/8) = 1.325 (exact 1.3557)
-        let (w2, m1) = s.mode(s.width);
+        // the equivalent rectangular tank gives ω²R/g = (π/2) tanh(π²/8) = 1.325 ...
+        let (w2, m1) = s.mode(s.width).unwrap();
         let lam = w2 * r / GRAVITY;
         assert!((lam - 0.5 * std::f64::consts::PI * (std::f64::consts::PI.powi(2) / 8.0).tanh()).abs() < 1e-12);
-        assert!((lam / 1.3557 - 1.0).abs() < 0.03, "lambda {lam}");
         assert!(m1 > 0.0 && m1 < s.mass);
+        // ... but the circle's lateral mode is the cylinder's, shared with the vehicle model:
+        // λ = 1.3557 (Budiansky; McIver 1989), m_W = m d̄ λ / R, pendulum length R/λ
+        let (w2, m1) = s.lateral_mode(r, r).unwrap();
+        let lam = w2 * r / GRAVITY;
+        assert!((lam - 1.3557).abs() < 3e-4, "lambda {lam}");
+        assert!((m1 - s.mass * (-s.z_com) * lam / r).abs() < 1e-9 * s.mass);
+        let p = Pendulum::new(&config(r, r, 0.5), 0.0).unwrap();
+        assert!((p.bobs[1].length - r / lam).abs() < 1e-12);
+        // an ellipse keeps the equivalent rectangular tank
+        let e = LiquidSection::new(&config(0.6, 0.4, 0.5));
+        assert_eq!(e.lateral_mode(0.6, 0.4).unwrap(), e.mode(e.width).unwrap());
+    }
+
+    /// The longitudinal mode is the vehicle model's rectangular-tank mode.
+    #[test]
+    fn longitudinal_mode_is_the_vehicle_models() {
+        let c = config(0.4, 0.3, 0.7);
+        let s = LiquidSection::new(&c);
+        let (omega, m) = rectangular_mode(c.length, s.mean_depth, s.mass, GRAVITY).unwrap();
+        let (w2, m1) = s.mode(c.length).unwrap();
+        assert_eq!((w2, m1), (omega * omega, m));
     }
 
     #[test]
@@ -366,15 +382,15 @@ mod tests {
         p.advance(40.0, &u, &u).unwrap();
         let out = p.outputs(&u);
         let m = p.mass();
-        let expect = scale(m, sub(u.gravity, u.acceleration));
+        let expect = m * (V3::from(u.gravity) - V3::from(u.acceleration));
         for i in 0..3 {
             assert!((out.force[i] - expect[i]).abs() < 1e-6 * m, "force {i}: {:?} vs {expect:?}", out.force);
         }
         let th = p.angles();
         assert!((th[1] - (-(2.0f64 / GRAVITY).atan())).abs() < 1e-8, "lateral angle {}", th[1]);
         assert!((th[0] - (-(0.5f64 / GRAVITY).atan())).abs() < 1e-8);
-        let mom = cross(sub(out.com, c.reference), expect);
-        for (got, want) in out.moment.iter().zip(mom) {
+        let mom = (V3::from(out.com) - V3::from(c.reference)).cross(&expect);
+        for (got, want) in out.moment.iter().zip(mom.iter()) {
             assert!((got - want).abs() < 1e-6 * m);
         }
     }
@@ -421,17 +437,17 @@ mod tests {
         u.angular_acceleration = [0.5, 0.2, 0.7];
         let out = p.outputs(&u);
         let r = p.com0;
-        let w = u.angular_velocity;
-        let a = add(cross(u.angular_acceleration, r), cross(w, cross(w, r)));
-        let g_a = sub(u.gravity, a);
+        let w = V3::from(u.angular_velocity);
+        let a = V3::from(u.angular_acceleration).cross(&r) + w.cross(&w.cross(&r));
+        let g_a = V3::from(u.gravity) - a;
         let m = p.mass();
         let [m_long, m_lat] = p.sloshing_masses();
         assert!((out.force[0] - (m - m_long) * g_a[0]).abs() < 1e-9 * m);
         assert!((out.force[1] - (m - m_lat) * g_a[1]).abs() < 1e-9 * m);
         assert!((out.force[2] - m * g_a[2]).abs() < 1e-9 * m);
         // moment about the origin: all masses at r̄
-        let mom = cross(r, out.force);
-        for (got, want) in out.moment.iter().zip(mom) {
+        let mom = r.cross(&V3::from(out.force));
+        for (got, want) in out.moment.iter().zip(mom.iter()) {
             assert!((got - want).abs() < 1e-9 * m);
         }
     }

@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from railslosh import _core
 from railslosh.constants import GRAVITY
 from railslosh.cosim.protocol import (
     check_load,
@@ -235,7 +236,9 @@ def horizontal_cylinder(
     Model of notes §3 [derived]: the wall pressure is radial, so the inviscid liquid exerts no
     moment about the axis and its load passes through the axis; hence a pendulum **hinged on the
     axis** with the rigid mass m0 **on the axis**. Its length l1 = R/λ sets ω1² = λ g/R with
-    λ from :func:`cylinder_lambda` (or ``lam``); static-tilt matching (Σ m l = M BM, BM = d for a
+    λ from the vehicle model's table (``_core.equivalent_lambda``, the one the vehicle runs and the
+    FMU use; :func:`cylinder_lambda` is the independent Steklov solve that checks it) or ``lam``,
+    for liquid depths of 1–95 % of the diameter; static-tilt matching (Σ m l = M BM, BM = d for a
     circle) gives m1 = M d λ / R, d the centroid depth of :func:`segment_geometry`. Half full:
     λ = 1.3557, l1 = 0.738 R, m1 = 0.575 M. Longitudinal sloshing is not modelled (rigid along x)."""
     radius = check_positive("radius", radius)
@@ -244,7 +247,7 @@ def horizontal_cylinder(
     if not 0 < fill < 1:
         raise invalid("fill", fill, "0 < fill < 1 (liquid depth / diameter)")
     seg = segment_geometry(radius, fill * 2 * radius)
-    lam = cylinder_lambda(fill) if lam is None else check_positive("lam", lam)
+    lam = _core.equivalent_lambda(fill) if lam is None else check_positive("lam", lam)
     mass = density * seg["area"] * length
     m1 = min(mass * seg["centroid_depth"] * lam / radius, mass)
     l1 = radius / lam

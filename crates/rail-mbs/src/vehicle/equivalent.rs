@@ -140,6 +140,15 @@ pub fn cylinder_lambda(depth_fraction: f64) -> Result<f64, AncfError> {
     Ok(s)
 }
 
+/// First transverse sloshing mode of liquid of mass `mass` in a horizontal circular cylinder of
+/// radius `radius` with eigenvalue `lambda` ([`cylinder_lambda`]) and centroid `centroid_depth`
+/// below the axis: `(ω, m₁)` with `ω² = λ g/R` (pendulum length `l₁ = g/ω² = R/λ`) and, from
+/// static-tilt matching (`m₁ l₁ = M BM`, `BM = d` for a circle: the metacentre is on the axis),
+/// `m₁ = min(M d λ/R, M)`. Used by the vehicle's equivalent model and the FMU's pendulum.
+pub fn cylinder_lateral_mode(radius: f64, lambda: f64, mass: f64, centroid_depth: f64, g: f64) -> (f64, f64) {
+    ((lambda * g / radius).sqrt(), (mass * centroid_depth * lambda / radius).min(mass))
+}
+
 /// A circular segment: the liquid cross-section of a horizontal cylinder.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Segment {
@@ -336,8 +345,7 @@ impl EquivalentCargo {
                 }
                 SloshAxis::Lateral => {
                     let l1 = r / lam;
-                    let omega = (lam * g / r).sqrt();
-                    let m1 = (c.mass * (-zc) * lam / r).min(c.mass);
+                    let (omega, m1) = cylinder_lateral_mode(r, lam, c.mass, -zc, g);
                     SloshMode {
                         compartment: i,
                         mass: m1,
