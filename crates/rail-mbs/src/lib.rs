@@ -14,10 +14,12 @@
 
 pub mod cosim;
 pub mod defaults;
+pub mod fluid_blocks;
 pub mod integrator;
 pub mod invariants;
 pub mod maneuvers;
 pub mod mbs;
+pub mod observe;
 pub mod profile;
 pub mod slosh;
 pub mod track;

@@ -153,6 +153,19 @@ pub enum SystemError {
     Other(String),
 }
 
+impl From<ancf_core::error::AncfError> for SystemError {
+    /// A fluid-body error as the system error that locates it: an inverted element keeps its
+    /// element, point and J; a non-finite element value its element; anything else is `Other`.
+    fn from(e: ancf_core::error::AncfError) -> Self {
+        use ancf_core::error::AncfError;
+        match e {
+            AncfError::InvertedElement { element, point, j } => SystemError::InvertedElement { element, point, j },
+            AncfError::NonFinite { element, what } => SystemError::Element { index: element, reason: what },
+            other => SystemError::Other(other.to_string()),
+        }
+    }
+}
+
 /// Which quantity was found non-finite (NaN or ±inf).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Quantity {

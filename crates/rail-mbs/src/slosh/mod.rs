@@ -21,7 +21,7 @@ use crate::integrator::{
     Checkpoint, CheckpointFile, Explicit, ExplicitParams, Hht, HhtParams, IntegratorError, Journal, Stats,
 };
 use crate::invariants::{EnergySample, InvariantMonitor, Margins};
-use crate::vehicle::{Observer, Progress};
+use crate::observe::{Observer, Progress};
 
 /// Time series recorded by a slosh run. Loads are the force and moment the fluid exerts on
 /// the tank (through wall and bulkhead contact), moments about the tank origin.

@@ -12,8 +12,6 @@
 //!
 //! Generalized forces: Q = −f_int(e, ė) + Q_gravity + Q_contact (+ pseudo-forces).
 
-use std::collections::HashMap;
-
 use ancf_core::FluidBody;
 use ancf_core::body::{ElementJacobian, ForceWorkspace};
 use ancf_core::constitutive::M3;
@@ -23,6 +21,7 @@ use ancf_core::shape::N_SHAPE;
 use nalgebra::Vector3;
 
 use super::motion::{PrescribedMotion, TankFrameInput};
+use crate::fluid_blocks::FluidBlocks;
 use crate::integrator::{LinearSolverKind, MechanicalSystem, SparsityPattern, SystemError};
 
 /// Which frame the fluid coordinates are written in.
@@ -65,8 +64,7 @@ pub struct SloshSystem {
     /// [`crate::cosim`]). `None` from [`SloshSystem::new`].
     pub tank_input: Option<TankFrameInput>,
     pattern: Vec<(usize, usize)>,
-    blocks: HashMap<(usize, usize), usize>,
-    element_blocks: Vec<[usize; 64]>,
+    layout: FluidBlocks,
     point_jac: Vec<PointJacobian>,
     /// Reused buffers: force evaluation and element Jacobians.
     workspace: ForceWorkspace,
@@ -90,49 +88,7 @@ impl SloshSystem {
     }
 }
 
-/// Default penetration limit relative to the smallest element edge: a contact point
-/// half an element deep in the wall means the penalty contact no longer represents
-/// the wall.
-pub const PENETRATION_LIMIT_FACTOR: f64 = 0.5;
-
-fn sys_err(e: AncfError) -> SystemError {
-    match e {
-        AncfError::InvertedElement { element, point, j } => SystemError::InvertedElement { element, point, j },
-        AncfError::NonFinite { element, what } => SystemError::Element { index: element, reason: what },
-        other => SystemError::Other(other.to_string()),
-    }
-}
-
-/// Subtracts every element's exact Jacobians `∂f/∂e`, `∂f/∂ė` (internal forces enter
-/// `Q` with a minus sign) from pattern values laid out in 12×12 node-pair blocks, whose
-/// starts per element are `element_blocks` (as built by [`SloshSystem::new`]).
-pub(crate) fn subtract_element_jacobians(
-    body: &FluidBody,
-    element_blocks: &[[usize; 64]],
-    e: &[f64],
-    edot: &[f64],
-    dq: &mut [f64],
-    dv: &mut [f64],
-    jacs: &mut Vec<ElementJacobian>,
-) -> Result<(), SystemError> {
-    body.element_jacobians_into(e, edot, jacs).map_err(sys_err)?;
-    for (el, jac) in jacs.iter().enumerate() {
-        let eb = &element_blocks[el];
-        for a in 0..N_SHAPE {
-            for b in 0..N_SHAPE {
-                for i in 0..3 {
-                    let row = 96 * (3 * a + i);
-                    for k in 0..3 {
-                        let idx = SloshSystem::element_index(eb, a, i, b, k);
-                        dq[idx] -= jac.stiffness[row + 3 * b + k];
-                        dv[idx] -= jac.damping[row + 3 * b + k];
-                    }
-                }
-            }
-        }
-    }
-    Ok(())
-}
+pub use crate::fluid_blocks::PENETRATION_LIMIT_FACTOR;
 
 impl SloshSystem {
     /// Assemble the system and its fixed sparsity pattern (12×12 blocks for every pair of
@@ -145,31 +101,11 @@ impl SloshSystem {
         frame: SloshFrame,
     ) -> Result<Self, AncfError> {
         motion.validate()?;
-        let mut blocks = HashMap::new();
         let mut pattern = Vec::new();
-        let mut element_blocks = Vec::with_capacity(body.mesh.n_elements());
-        for nodes in &body.mesh.elements {
-            let mut eb = [0usize; 64];
-            for (i, &ni) in nodes.iter().enumerate() {
-                for (j, &nj) in nodes.iter().enumerate() {
-                    let start = *blocks.entry((ni, nj)).or_insert_with(|| {
-                        let s = pattern.len();
-                        for r in 0..12 {
-                            for c in 0..12 {
-                                pattern.push((12 * ni + r, 12 * nj + c));
-                            }
-                        }
-                        s
-                    });
-                    eb[8 * i + j] = start;
-                }
-            }
-            element_blocks.push(eb);
-        }
-        let min_edge = body.elements.iter().flat_map(|e| e.lengths).fold(f64::INFINITY, f64::min);
+        let layout = FluidBlocks::append(&body, 0, &mut pattern);
         let reference_volume = body.volume(&body.reference_coordinates());
         Ok(Self {
-            penetration_limit: PENETRATION_LIMIT_FACTOR * min_edge,
+            penetration_limit: crate::fluid_blocks::default_penetration_limit(&body),
             volume_tolerance: 0.01,
             reference_volume,
             body,
@@ -180,8 +116,7 @@ impl SloshSystem {
             tank_input: None,
             linear_solver: LinearSolverKind::Direct,
             pattern,
-            blocks,
-            element_blocks,
+            layout,
             point_jac: Vec::new(),
             workspace: ForceWorkspace::default(),
             jacobians: Vec::new(),
@@ -218,7 +153,7 @@ impl SloshSystem {
     }
 
     fn value_index(&self, row: usize, col: usize) -> usize {
-        self.blocks[&(row / 12, col / 12)] + (row % 12) * 12 + col % 12
+        self.layout.value_index(row, col)
     }
 
     /// Tank-frame gravity, linear acceleration, ω and ω̇ (tank components) at t.
@@ -254,13 +189,6 @@ impl SloshSystem {
         }
         let wx = w.cross_matrix();
         Some((wd.cross_matrix() + wx * wx, 2.0 * wx))
-    }
-
-    /// Pattern index of entry (compact 3a + i, compact 3b + k) of an element whose node-pair
-    /// blocks start at `eb`.
-    #[inline]
-    pub(crate) fn element_index(eb: &[usize; 64], a: usize, i: usize, b: usize, k: usize) -> usize {
-        eb[8 * (a / 4) + b / 4] + (3 * (a % 4) + i) * 12 + 3 * (b % 4) + k
     }
 
     /// Tank-frame formulation: the power of gravity and of the pseudo-forces on the
@@ -356,7 +284,7 @@ impl MechanicalSystem for SloshSystem {
     }
 
     fn forces(&mut self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) -> Result<(), SystemError> {
-        self.body.internal_forces_with(&mut self.workspace, q, v, out).map_err(sys_err)?;
+        self.body.internal_forces_with(&mut self.workspace, q, v, out).map_err(SystemError::from)?;
         out.iter_mut().for_each(|x| *x = -*x);
         let gs = self.body.gravity_scale();
         let (g, alin) = match self.frame {
@@ -430,7 +358,7 @@ impl MechanicalSystem for SloshSystem {
         dq: &mut [f64],
         dv: &mut [f64],
     ) -> Result<(), SystemError> {
-        subtract_element_jacobians(&self.body, &self.element_blocks, q, v, dq, dv, &mut self.jacobians)?;
+        self.layout.subtract_element_jacobians(&self.body, q, v, dq, dv, &mut self.jacobians)?;
         if let Some((b, wc)) = self.rotation_terms(t) {
             let m = self.body.scalar_mass().as_ref();
             for j in 0..m.ncols() {
@@ -451,7 +379,7 @@ impl MechanicalSystem for SloshSystem {
         self.contact.forces(&self.body, &kin, q, v, &mut scratch, Some(&mut pj));
         for p in &pj {
             let pt = &self.contact.points[p.point];
-            let eb = &self.element_blocks[pt.element];
+            let eb = &self.layout.element_blocks[pt.element];
             for a in 0..N_SHAPE {
                 for b in 0..N_SHAPE {
                     let nn = pt.shape[a] * pt.shape[b];
@@ -460,7 +388,7 @@ impl MechanicalSystem for SloshSystem {
                     }
                     for i in 0..3 {
                         for k in 0..3 {
-                            let idx = Self::element_index(eb, a, i, b, k);
+                            let idx = FluidBlocks::element_index(eb, a, i, b, k);
                             dq[idx] += nn * p.d_position[(i, k)];
                             dv[idx] += nn * p.d_velocity[(i, k)];
                         }

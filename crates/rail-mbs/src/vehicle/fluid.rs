@@ -22,8 +22,6 @@
 //! The coupling blocks are what keeps Newton convergent when the tank is light compared
 //! with its fluid (the added-mass instability of explicit coupling, seed 003).
 
-use std::collections::HashMap;
-
 use ancf_core::FluidBody;
 use ancf_core::body::{ElementJacobian, ForceWorkspace};
 use ancf_core::contact::{PointJacobian, TankKinematics, WallContact};
@@ -31,6 +29,7 @@ use ancf_core::error::AncfError;
 use ancf_core::shape::N_SHAPE;
 use nalgebra::{Matrix3, Vector3};
 
+use crate::fluid_blocks::FluidBlocks;
 use crate::integrator::{KktIndex, MechanicalSystem, SparsityPattern, SystemError};
 use crate::invariants::{
     EnergySample, InvariantLimits, InvariantMonitor, Margins, Pending, check_state, stored_energy, wall_power,
@@ -56,10 +55,8 @@ pub struct TankFluid {
 struct FluidLayout {
     /// First global coordinate of the fluid.
     offset: usize,
-    /// Pattern index of each node-pair 12×12 block.
-    blocks: HashMap<(usize, usize), usize>,
-    /// Per element: the 64 node-pair block starts.
-    element_blocks: Vec<[usize; 64]>,
+    /// The fluid's node-pair blocks.
+    blocks: FluidBlocks,
     /// Pattern start of the 7 × n_f tank-rows block (row-major) and of the n_f × 7
     /// fluid-rows block (row-major).
     tank_rows: usize,
@@ -91,14 +88,6 @@ pub struct FluidVehicle {
     monitors: Vec<InvariantMonitor>,
     /// Each fluid's assessed state in the step being checked (committed once all pass).
     pending: Vec<Option<Pending>>,
-}
-
-fn sys_err(e: AncfError) -> SystemError {
-    match e {
-        AncfError::InvertedElement { element, point, j } => SystemError::InvertedElement { element, point, j },
-        AncfError::NonFinite { element, what } => SystemError::Element { index: element, reason: what },
-        other => SystemError::Other(other.to_string()),
-    }
 }
 
 /// Tank kinematics for the contact from a body state.
@@ -159,10 +148,9 @@ impl FluidVehicle {
     /// Largest admissible penetration of fluid `k` (m): [`PENETRATION_LIMIT_FACTOR`] × its
     /// smallest element edge, as in `SloshSystem`.
     ///
-    /// [`PENETRATION_LIMIT_FACTOR`]: crate::slosh::system::PENETRATION_LIMIT_FACTOR
+    /// [`PENETRATION_LIMIT_FACTOR`]: crate::fluid_blocks::PENETRATION_LIMIT_FACTOR
     fn penetration_limit(&self, k: usize) -> f64 {
-        let min_edge = self.fluids[k].body.elements.iter().flat_map(|el| el.lengths).fold(f64::INFINITY, f64::min);
-        crate::slosh::system::PENETRATION_LIMIT_FACTOR * min_edge
+        crate::fluid_blocks::default_penetration_limit(&self.fluids[k].body)
     }
 
     fn build_pattern(&self) -> (SparsityPattern, Vec<FluidLayout>) {
@@ -170,25 +158,8 @@ impl FluidVehicle {
         let mut layouts = Vec::new();
         let mut offset = self.n_rigid;
         for f in &self.fluids {
-            let mut lay = FluidLayout { offset, ..Default::default() };
-            for nodes in &f.body.mesh.elements {
-                let mut eb = [0usize; 64];
-                for (i, &ni) in nodes.iter().enumerate() {
-                    for (j, &nj) in nodes.iter().enumerate() {
-                        let start = *lay.blocks.entry((ni, nj)).or_insert_with(|| {
-                            let s = pat.dynamics.len();
-                            for r in 0..12 {
-                                for c in 0..12 {
-                                    pat.dynamics.push((offset + 12 * ni + r, offset + 12 * nj + c));
-                                }
-                            }
-                            s
-                        });
-                        eb[8 * i + j] = start;
-                    }
-                }
-                lay.element_blocks.push(eb);
-            }
+            let blocks = FluidBlocks::append(&f.body, offset, &mut pat.dynamics);
+            let mut lay = FluidLayout { offset, blocks, ..Default::default() };
             let nf = f.body.n_coords();
             let t0 = 7 * f.tank.0;
             lay.tank_rows = pat.dynamics.len();
@@ -208,7 +179,7 @@ impl FluidVehicle {
                 for (i, val) in m.row_idx_of_col(j).zip(m.val_of_col(j)) {
                     for k in 0..3 {
                         let (r, c) = (3 * i + k, 3 * j + k);
-                        lay.mass_entries.push((lay.blocks[&(r / 12, c / 12)] + (r % 12) * 12 + c % 12, *val));
+                        lay.mass_entries.push((lay.blocks.value_index(r, c), *val));
                     }
                 }
             }
@@ -328,7 +299,7 @@ impl MechanicalSystem for FluidVehicle {
             let n = f.body.n_coords();
             let (e, ed) = (&q[lay.offset..lay.offset + n], &v[lay.offset..lay.offset + n]);
             let of = &mut out[lay.offset..lay.offset + n];
-            f.body.internal_forces_with(&mut self.workspaces[k], e, ed, of).map_err(sys_err)?;
+            f.body.internal_forces_with(&mut self.workspaces[k], e, ed, of).map_err(SystemError::from)?;
             of.iter_mut().for_each(|x| *x = -*x);
             for (s, o) in f.body.gravity_scale().iter().zip(of.chunks_exact_mut(3)) {
                 for i in 0..3 {
@@ -418,17 +389,9 @@ impl MechanicalSystem for FluidVehicle {
             let f = &self.fluids[k];
             let n = f.body.n_coords();
             let (e, ed) = (&q[lay.offset..lay.offset + n], &v[lay.offset..lay.offset + n]);
-            let idx = crate::slosh::system::SloshSystem::element_index;
+            let idx = FluidBlocks::element_index;
             // Fluid–fluid: element Jacobians.
-            crate::slosh::system::subtract_element_jacobians(
-                &f.body,
-                &lay.element_blocks,
-                e,
-                ed,
-                dq,
-                dv,
-                &mut self.jacobians,
-            )?;
+            lay.blocks.subtract_element_jacobians(&f.body, e, ed, dq, dv, &mut self.jacobians)?;
             // Contact: fluid–fluid point Jacobians and the exact tank rows.
             let tank = self.mb.state(Some(f.tank), &q[..nr], &v[..nr]);
             // The contact passes add their forces into `base` and `fp`: zero them first.
@@ -438,7 +401,7 @@ impl MechanicalSystem for FluidVehicle {
             let et2 = crate::mbs::rotation::e_matrix(&tank.params).transpose() * 2.0;
             for p in &pj {
                 let pt = &f.contact.points[p.point];
-                let eb = &lay.element_blocks[pt.element];
+                let eb = &lay.blocks.element_blocks[pt.element];
                 let nodes = &f.body.mesh.elements[pt.element];
                 let dm_dr: Matrix3<f64> = p.force.cross_matrix() - p.arm.cross_matrix() * p.d_position;
                 let dm_dv: Matrix3<f64> = -(p.arm.cross_matrix() * p.d_velocity);
