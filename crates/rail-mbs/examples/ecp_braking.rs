@@ -1,5 +1,5 @@
 //! One braking run of the crude-oil studies with its wall time and Newton statistics:
-//! `cargo run --release -p rail-mbs --example ecp_braking -- [light|medium|heavy|water] [nx ny nz] [t_end] [ecp|conventional] [bulkheads|-] [wall_damping_ratio]`
+//! `cargo run --release -p rail-mbs --example ecp_braking -- [light|medium|heavy|water] [nx ny nz] [t_end] [ecp|conventional] [bulkheads|-] [wall_damping_ratio] [condensed|direct]`
 use rail_mbs::defaults::{Oil, SETTLE};
 use rail_mbs::vehicle::BrakeScope;
 use rail_mbs::vehicle::studies::{BrakingCase, run_braking};
@@ -14,8 +14,22 @@ fn main() {
         if a.get(5).map(|s| s.as_str()) == Some("conventional") { BrakeScope::FrontCar } else { BrakeScope::AllCars };
     let bulkheads = a.get(6).map(|s| s.as_str()) == Some("bulkheads");
     let wall_damping_ratio = a.get(7).map_or(ancf_core::contact::WALL_DAMPING_RATIO, |s| s.parse().unwrap());
-    let case =
-        BrakingCase { oil, cars: 2, scope, bulkheads, counts, t_end, rear_brake_factor: 1.0, wall_damping_ratio };
+    let linear_solver = if a.get(8).map(|s| s.as_str()) == Some("direct") {
+        rail_mbs::integrator::LinearSolverKind::Direct
+    } else {
+        rail_mbs::integrator::LinearSolverKind::Condensed
+    };
+    let case = BrakingCase {
+        oil,
+        cars: 2,
+        scope,
+        bulkheads,
+        counts,
+        t_end,
+        rear_brake_factor: 1.0,
+        wall_damping_ratio,
+        linear_solver,
+    };
     let r = run_braking(&case).expect("run");
     let s = &r.train;
     let peak = s.coupler_force.iter().map(|c| c[0].abs()).fold(0.0, f64::max);

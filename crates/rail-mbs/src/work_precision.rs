@@ -285,6 +285,7 @@ fn ecp_braking(
             t_end,
             rear_brake_factor,
             wall_damping_ratio: ancf_core::contact::WALL_DAMPING_RATIO,
+            linear_solver: crate::integrator::LinearSolverKind::Condensed,
         };
         let tic = Instant::now();
         let out = run_braking_with(&case, s.step, s.rel_tol);

@@ -217,7 +217,8 @@ impl<S: MechanicalSystem> Hht<S> {
                 what: format!("constraint pattern entry {k} = ({r}, {c}) outside {m} x {n}"),
             });
         }
-        let kkt = KktSolver::new(n, m, &pattern, params.linear_residual_tol, system.linear_solver())
+        let blocks = system.condensed_blocks();
+        let kkt = KktSolver::new(n, m, &pattern, params.linear_residual_tol, system.linear_solver(), &blocks)
             .map_err(|e| linear_error(e, t0, 0.0))?;
         let nd = pattern.dynamics.len();
         let nc = pattern.constraints.len();

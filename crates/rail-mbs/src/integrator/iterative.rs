@@ -41,6 +41,12 @@ pub enum LinearSolverKind {
     /// Sparse LU (faer) with the symbolic factorization computed once: any system.
     #[default]
     Direct,
+    /// Static condensation (`integrator::condensed`): each coordinate block of
+    /// [`MechanicalSystem::condensed_blocks`](super::MechanicalSystem::condensed_blocks) gets its
+    /// own sparse LU and the rest is solved through its Schur complement. For systems of
+    /// independent sub-bodies coupled through a few coordinates (the fluids of a fluid
+    /// vehicle, each coupled only to its tank body). Without blocks it is [`Self::Direct`].
+    Condensed,
     /// Restarted GMRES with block-Jacobi preconditioning: unconstrained systems only
     /// (no Lagrange multipliers), where the Newton matrix is mass-dominated.
     Iterative(IterativeParams),

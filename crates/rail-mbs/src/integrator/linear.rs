@@ -19,6 +19,7 @@ use faer::sparse::linalg::lu::{NumericLu, SymbolicLu, factorize_symbolic_lu};
 use faer::sparse::{Pair, SparseColMat, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par};
 
+use super::condensed::Condensed;
 use super::error::KktIndex;
 use super::iterative::{BlockJacobi, CsrView, Gmres, IterativeParams, LinearSolverKind};
 use super::system::SparsityPattern;
@@ -94,6 +95,9 @@ enum Backend {
     /// Sparse LU: symbolic factorization once, numeric LU per refresh (into the same
     /// [`NumericLu`], whose storage is reused); `factored` when it holds a valid LU.
     Direct { symbolic: Box<SymbolicLu<usize>>, numeric: Box<NumericLu<usize, f64>>, factored: bool },
+    /// Static condensation of the system's independent blocks onto the rest
+    /// ([`super::condensed`]); `factored` when its factors are valid.
+    Condensed { cond: Box<Condensed>, factored: bool },
     /// GMRES with block Jacobi: "factorizing" inverts the diagonal blocks.
     Iterative {
         params: IterativeParams,
@@ -114,6 +118,7 @@ impl KktSolver {
         pattern: &SparsityPattern,
         residual_tol: f64,
         kind: LinearSolverKind,
+        blocks: &[std::ops::Range<usize>],
     ) -> Result<Self, LinearFailure> {
         let dim = n + m;
         let mut pairs: Vec<Pair<usize, usize>> =
@@ -136,7 +141,16 @@ impl KktSolver {
         let cq_pos = pattern.constraints.iter().map(|&(k, j)| (pos(n + k, j), pos(j, n + k))).collect();
         let nnz = symbolic.row_idx().len();
         let matrix = SparseColMat::new(symbolic, vec![0.0; nnz]);
+        let kind =
+            if kind == LinearSolverKind::Condensed && blocks.is_empty() { LinearSolverKind::Direct } else { kind };
         let backend = match kind {
+            LinearSolverKind::Condensed => {
+                let sym = matrix.symbolic();
+                Backend::Condensed {
+                    cond: Box::new(Condensed::new(dim, sym.col_ptr(), sym.row_idx(), blocks)?),
+                    factored: false,
+                }
+            }
             LinearSolverKind::Direct => Backend::Direct {
                 symbolic: Box::new(
                     factorize_symbolic_lu(matrix.symbolic(), Default::default())
@@ -189,7 +203,7 @@ impl KktSolver {
     /// Total Krylov iterations of the iterative backend so far (0 for the direct one).
     pub(crate) fn linear_iterations(&self) -> usize {
         match &self.backend {
-            Backend::Direct { .. } => 0,
+            Backend::Direct { .. } | Backend::Condensed { .. } => 0,
             Backend::Iterative { iterations, .. } => *iterations,
         }
     }
@@ -217,7 +231,9 @@ impl KktSolver {
     /// Numeric LU of the current values, reusing the symbolic factorization.
     pub(crate) fn factorize(&mut self) -> Result<(), LinearFailure> {
         match &mut self.backend {
-            Backend::Direct { factored, .. } | Backend::Iterative { factored, .. } => *factored = false,
+            Backend::Direct { factored, .. }
+            | Backend::Condensed { factored, .. }
+            | Backend::Iterative { factored, .. } => *factored = false,
         }
         if self.matrix.val().iter().any(|v| !v.is_finite()) {
             return Err(LinearFailure::Numeric(None));
@@ -225,6 +241,11 @@ impl KktSolver {
         self.a_max = inf_norm(self.matrix.val());
         let (symbolic, numeric, factored) = match &mut self.backend {
             Backend::Direct { symbolic, numeric, factored } => (symbolic, numeric, factored),
+            Backend::Condensed { cond, factored } => {
+                cond.factor(self.matrix.val())?;
+                *factored = true;
+                return Ok(());
+            }
             Backend::Iterative { csr, prec, factored, .. } => {
                 csr.gather(self.matrix.val());
                 prec.factor(csr).map_err(LinearFailure::NoPivot)?;
@@ -263,9 +284,10 @@ impl KktSolver {
     /// refinement if the residual is too large.
     pub(crate) fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearFailure> {
         let dim = self.n + self.m;
-        let (symbolic, numeric) = match &mut self.backend {
-            Backend::Direct { symbolic, numeric, factored: true } => (&**symbolic, &**numeric),
-            Backend::Direct { factored: false, .. } | Backend::Iterative { factored: false, .. } => {
+        match &mut self.backend {
+            Backend::Direct { factored: false, .. }
+            | Backend::Condensed { factored: false, .. }
+            | Backend::Iterative { factored: false, .. } => {
                 return Err(LinearFailure::Numeric(None));
             }
             Backend::Iterative { params, csr, prec, gmres, iterations, .. } => {
@@ -278,15 +300,10 @@ impl KktSolver {
                 }
                 return if report.converged { Ok(()) } else { Err(LinearFailure::Numeric(None)) };
             }
-        };
-        let par = parallelism();
-        let stack = self.scratch.stack(symbolic.solve_in_place_scratch::<f64>(1, par))?;
-        // `numeric` is the output of `symbolic.factorize_numeric_lu` for this matrix pattern
-        // (`factored` is set only after it succeeded).
-        let lu = faer::sparse::linalg::lu::LuRef::new_unchecked(symbolic, numeric);
+            Backend::Direct { .. } | Backend::Condensed { .. } => {}
+        }
         self.rhs_copy.copy_from_slice(rhs);
-        lu.solve_in_place_with_conj(Conj::No, MatMut::from_column_major_slice_mut(rhs, dim, 1), par, stack);
-        ancf_core::clear_upper_simd();
+        apply_inverse(&mut self.backend, &mut self.scratch, dim, rhs)?;
         for refinement in 0..2 {
             if let Some(i) = rhs.iter().position(|v| !v.is_finite()) {
                 return Err(LinearFailure::Numeric(Some(KktIndex::from_raw(i, self.n))));
@@ -310,18 +327,30 @@ impl KktSolver {
             if refinement == 1 {
                 break;
             }
-            lu.solve_in_place_with_conj(
-                Conj::No,
-                MatMut::from_column_major_slice_mut(&mut self.work, dim, 1),
-                par,
-                &mut *stack,
-            );
-            ancf_core::clear_upper_simd();
+            apply_inverse(&mut self.backend, &mut self.scratch, dim, &mut self.work)?;
             for (x, d) in rhs.iter_mut().zip(&self.work) {
                 *x += d;
             }
         }
         Err(LinearFailure::Numeric(None))
+    }
+}
+
+/// `x ← A⁻¹ x` with the factors of a direct or condensed backend.
+fn apply_inverse(backend: &mut Backend, scratch: &mut Scratch, dim: usize, x: &mut [f64]) -> Result<(), LinearFailure> {
+    match backend {
+        Backend::Direct { symbolic, numeric, .. } => {
+            let par = parallelism();
+            let stack = scratch.stack(symbolic.solve_in_place_scratch::<f64>(1, par))?;
+            // `numeric` is the output of `symbolic.factorize_numeric_lu` for this matrix pattern
+            // (the caller checked `factored`, set only after it succeeded).
+            let lu = faer::sparse::linalg::lu::LuRef::new_unchecked(symbolic, numeric);
+            lu.solve_in_place_with_conj(Conj::No, MatMut::from_column_major_slice_mut(x, dim, 1), par, stack);
+            ancf_core::clear_upper_simd();
+            Ok(())
+        }
+        Backend::Condensed { cond, .. } => cond.solve(x),
+        Backend::Iterative { .. } => Err(LinearFailure::Generic("apply_inverse: iterative backend".into())),
     }
 }
 
@@ -341,7 +370,7 @@ mod tests {
             dynamics: vec![(0, 0), (1, 1), (2, 2), (0, 1), (1, 0), (2, 1), (2, 2)],
             constraints: vec![(0, 0), (0, 2)],
         };
-        let mut kkt = KktSolver::new(3, 1, &pattern, 1e-12, LinearSolverKind::Direct).unwrap();
+        let mut kkt = KktSolver::new(3, 1, &pattern, 1e-12, LinearSolverKind::Direct, &[]).unwrap();
         let mass = [2.0, 3.0, 4.0, 0.0, 0.0, 0.0, 0.0];
         let dq = [-1.0, -1.0, -1.0, 0.5, 0.5, 0.25, -1.0];
         let dv = [-0.1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
@@ -367,6 +396,68 @@ mod tests {
         assert_eq!(kkt.nnz(), 3 + 3 + 4);
     }
 
+    /// Static condensation solves the same constrained system as one LU: two blocks of 12
+    /// unknowns, each coupled to 2 of the 6 outer coordinates, 2 constraints on the outer ones;
+    /// blocks that couple to each other or overlap are refused.
+    #[test]
+    fn condensed_backend_matches_direct() {
+        let (nb, no) = (12usize, 6usize);
+        let n = 2 * nb + no;
+        let mut dynamics = Vec::new();
+        for k in 0..2 {
+            let s = k * nb;
+            for i in 0..nb {
+                for j in i.saturating_sub(3)..(i + 4).min(nb) {
+                    dynamics.push((s + i, s + j));
+                }
+                // coupling to outer coordinates 2k and 2k + 1, both ways
+                for o in [2 * nb + 2 * k, 2 * nb + 2 * k + 1] {
+                    dynamics.push((s + i, o));
+                    dynamics.push((o, s + i));
+                }
+            }
+        }
+        for i in 2 * nb..n {
+            for j in 2 * nb..n {
+                dynamics.push((i, j));
+            }
+        }
+        let pattern = SparsityPattern { dynamics, constraints: vec![(0, 2 * nb), (0, 2 * nb + 3), (1, n - 1)] };
+        let value = |i: usize, j: usize, w: f64| -> f64 {
+            if i == j { 4.0 + w } else { (((i * 13 + j * 7) % 11) as f64 - 5.0) * 0.05 * w }
+        };
+        let mass: Vec<f64> = pattern.dynamics.iter().map(|&(i, j)| value(i, j, 1.0)).collect();
+        let dq: Vec<f64> = pattern.dynamics.iter().map(|&(i, j)| value(j, i, 0.3)).collect();
+        let dv: Vec<f64> = vec![0.0; pattern.dynamics.len()];
+        let cq = [1.0, -0.5, 2.0];
+        let b: Vec<f64> = (0..n + 2).map(|i| (0.7 * i as f64).sin() + 0.1).collect();
+        let blocks = [0..nb, nb..2 * nb];
+        let mut x = [b.clone(), b.clone()];
+        for (kind, x) in [LinearSolverKind::Direct, LinearSolverKind::Condensed].into_iter().zip(x.iter_mut()) {
+            let mut kkt = KktSolver::new(n, 2, &pattern, 1e-12, kind, &blocks).unwrap();
+            kkt.assemble(&mass, &dq, &dv, &cq, (1.0, 0.1, 0.5));
+            kkt.factorize().unwrap();
+            kkt.solve_in_place(x).unwrap();
+        }
+        let scale = x[0].iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        for (a, c) in x[0].iter().zip(&x[1]) {
+            assert!((a - c).abs() < 1e-12 * scale, "{a} vs {c}");
+        }
+        let err = |r: &[std::ops::Range<usize>]| match KktSolver::new(
+            n,
+            2,
+            &pattern,
+            1e-12,
+            LinearSolverKind::Condensed,
+            r,
+        ) {
+            Err(LinearFailure::Generic(m)) => m,
+            _ => String::new(),
+        };
+        assert!(err(&[0..nb + 1, nb + 1..2 * nb]).contains("coupled"));
+        assert!(err(&[0..nb, nb - 1..2 * nb]).contains("overlap"));
+    }
+
     /// The iterative backend solves the same unconstrained system as the direct one, and
     /// refuses a constrained one.
     #[test]
@@ -389,7 +480,7 @@ mod tests {
             .into_iter()
             .zip(x.iter_mut())
         {
-            let mut kkt = KktSolver::new(n, 0, &pattern, 1e-12, kind).unwrap();
+            let mut kkt = KktSolver::new(n, 0, &pattern, 1e-12, kind, &[]).unwrap();
             kkt.assemble(&mass, &dq, &dv, &[], coeffs);
             kkt.factorize().unwrap();
             kkt.solve_in_place(x).unwrap();
@@ -398,14 +489,14 @@ mod tests {
         assert!(err < 1e-9, "direct vs iterative: {err}");
         let constrained = SparsityPattern { dynamics: vec![(0, 0)], constraints: vec![(0, 0)] };
         let kind = LinearSolverKind::Iterative(IterativeParams::default());
-        assert!(matches!(KktSolver::new(1, 1, &constrained, 1e-12, kind), Err(LinearFailure::Generic(_))));
+        assert!(matches!(KktSolver::new(1, 1, &constrained, 1e-12, kind, &[]), Err(LinearFailure::Generic(_))));
     }
 
     #[test]
     fn zero_constraint_row_is_structurally_singular() {
         let pattern = SparsityPattern { dynamics: vec![(0, 0), (1, 1)], constraints: vec![(0, 0)] };
         // Constraint 1 has no Jacobian entries.
-        let mut kkt = KktSolver::new(2, 2, &pattern, 1e-12, LinearSolverKind::Direct).unwrap();
+        let mut kkt = KktSolver::new(2, 2, &pattern, 1e-12, LinearSolverKind::Direct, &[]).unwrap();
         kkt.assemble(&[1.0, 1.0], &[0.0; 2], &[0.0; 2], &[1.0], (1.0, 0.0, 0.0));
         assert!(matches!(kkt.factorize(), Err(LinearFailure::NoPivot(_))));
     }

@@ -128,6 +128,7 @@
 //! either); velocity-level constraint projection; allocation-free refactorization via
 //! faer's low-level LU API.
 
+mod condensed;
 mod error;
 mod explicit;
 mod hht;

@@ -84,6 +84,13 @@ pub trait MechanicalSystem {
         LinearSolverKind::Direct
     }
 
+    /// Coordinate ranges for [`LinearSolverKind::Condensed`]: each range couples (in the
+    /// pattern) only to unknowns outside every range (other coordinates, constraints), never
+    /// to another range. Called once, when the integrator is built. Default: none.
+    fn condensed_blocks(&self) -> Vec<std::ops::Range<usize>> {
+        Vec::new()
+    }
+
     /// Optional: the indices into `pattern().dynamics` where [`mass`] can write a
     /// non-zero value (at any `q`). The integrator then forms `M a` over these entries
     /// only. Default `None`: every pattern entry.

@@ -30,7 +30,7 @@ use ancf_core::shape::N_SHAPE;
 use nalgebra::{Matrix3, Vector3};
 
 use crate::fluid_blocks::FluidBlocks;
-use crate::integrator::{KktIndex, MechanicalSystem, SparsityPattern, SystemError};
+use crate::integrator::{KktIndex, LinearSolverKind, MechanicalSystem, SparsityPattern, SystemError};
 use crate::invariants::{
     EnergySample, InvariantLimits, InvariantMonitor, Margins, Pending, check_state, stored_energy, wall_power,
 };
@@ -72,6 +72,11 @@ pub struct FluidVehicle {
     pub mb: Multibody,
     /// The fluids.
     pub fluids: Vec<TankFluid>,
+    /// How the Newton matrix is solved: [`LinearSolverKind::Condensed`] (default; each fluid
+    /// factored on its own, the rest through the Schur complement) or
+    /// [`LinearSolverKind::Direct`] (one LU of the whole matrix); read when the integrator is
+    /// built. Both solve the same equations (docs/benchmarks.md).
+    pub linear_solver: LinearSolverKind,
     layouts: Vec<FluidLayout>,
     mb_entries: usize,
     n_rigid: usize,
@@ -114,6 +119,7 @@ impl FluidVehicle {
         let mut s = Self {
             mb,
             fluids,
+            linear_solver: LinearSolverKind::Condensed,
             layouts: Vec::new(),
             mb_entries,
             n_rigid,
@@ -267,6 +273,15 @@ impl MechanicalSystem for FluidVehicle {
 
     fn pattern(&self) -> SparsityPattern {
         self.build_pattern().0
+    }
+
+    fn linear_solver(&self) -> LinearSolverKind {
+        self.linear_solver
+    }
+
+    /// Each fluid's coordinates: they couple only to their tank body's.
+    fn condensed_blocks(&self) -> Vec<std::ops::Range<usize>> {
+        self.fluids.iter().zip(&self.layouts).map(|(f, lay)| lay.offset..lay.offset + f.body.n_coords()).collect()
     }
 
     fn mass_entries(&self) -> Option<Vec<usize>> {
@@ -542,6 +557,9 @@ pub struct FluidCargo {
     /// ([`ancf_core::contact::WallContactLaw::with_damping_ratio`]); default
     /// [`ancf_core::contact::WALL_DAMPING_RATIO`].
     pub wall_damping_ratio: f64,
+    /// How the coupled Newton matrix is solved ([`FluidVehicle::linear_solver`]); default
+    /// [`LinearSolverKind::Condensed`].
+    pub linear_solver: LinearSolverKind,
 }
 
 impl FluidCargo {
@@ -561,6 +579,7 @@ impl FluidCargo {
             wall_stiffness_factor: 1.0,
             contact_points_per_edge: 4,
             wall_damping_ratio: ancf_core::contact::WALL_DAMPING_RATIO,
+            linear_solver: LinearSolverKind::Condensed,
         }
     }
 }
@@ -710,7 +729,9 @@ pub fn build_fluid_train(
     let (mb, cars, couplers) = build_train(&sc2)?;
     let fluids =
         cars.iter().map(|c| TankFluid { tank: c.tank, body: body.clone(), contact: contact.clone() }).collect();
-    Ok((FluidVehicle::new(mb, fluids)?, cars, couplers))
+    let mut vehicle = FluidVehicle::new(mb, fluids)?;
+    vehicle.linear_solver = cargo.linear_solver;
+    Ok((vehicle, cars, couplers))
 }
 
 fn record_fluid(sys: &FluidVehicle, q: &[f64], v: &[f64], rec: &mut FluidTrainRecord) {

@@ -64,6 +64,8 @@ pub struct BrakingCase {
     /// the library default [`ancf_core::contact::WALL_DAMPING_RATIO`], or 1 as the shipped ECP
     /// scenes use).
     pub wall_damping_ratio: f64,
+    /// How the coupled Newton matrix is solved ([`FluidCargo::linear_solver`]).
+    pub linear_solver: crate::integrator::LinearSolverKind,
 }
 
 fn tangent() -> Result<Arc<Track>> {
@@ -97,6 +99,7 @@ pub fn run_braking_with(case: &BrakingCase, step: f64, rel_tol: f64) -> Result<F
     let p = TankCarParams::standard()?;
     let mut cg = cargo(case.oil, case.counts, case.bulkheads, &p)?;
     cg.wall_damping_ratio = case.wall_damping_ratio;
+    cg.linear_solver = case.linear_solver;
     let v0 = 40.0 / 3.6;
     let mut sc = TrainScenario::single(p.clone(), tangent()?, 300.0, v0, case.t_end);
     sc.cars = case.cars;
@@ -205,6 +208,7 @@ fn braking(oil: Oil, cars: usize, scope: BrakeScope, bulkheads: bool, quick: boo
         t_end,
         rear_brake_factor: rear,
         wall_damping_ratio: ancf_core::contact::WALL_DAMPING_RATIO,
+        linear_solver: crate::integrator::LinearSolverKind::Condensed,
     }
 }
 
@@ -506,6 +510,7 @@ fn mesh_convergence(quick: bool) -> Result<Vec<Record>> {
                     t_end,
                     rear_brake_factor: 1.0,
                     wall_damping_ratio: ancf_core::contact::WALL_DAMPING_RATIO,
+                    linear_solver: crate::integrator::LinearSolverKind::Condensed,
                 })
             }) as Job<'static, FluidTrainRecord>
         })
@@ -577,6 +582,7 @@ fn coupler_force_convergence(quick: bool) -> Result<Vec<Record>> {
             t_end,
             rear_brake_factor: 1.0,
             wall_damping_ratio: 1.0,
+            linear_solver: crate::integrator::LinearSolverKind::Condensed,
         };
         for m in meshes {
             jobs.push(Box::new(move || run_braking(&case(m))));
