@@ -25,13 +25,12 @@ from pathlib import Path
 import numpy as np
 
 from railslosh.constants import GRAVITY
+from railslosh.records import CaseSkipped, Record, within
 
 INPUTS = tuple(f"{g}_{c}" for g in ("a", "omega", "omega_dot", "gravity") for c in "xyz")
 OUTPUTS = tuple(f"{g}_{c}" for g in ("F", "M", "com") for c in "xyz")
 # default tank of the FMU: the SwRI elliptical tank of seed 003, half full of water
 SWRI = {"length": 0.324, "semi_axis_y": 0.208585, "semi_axis_z": 0.132131}
-
-Record = dict[str, object]
 
 
 class FmuUnavailable(RuntimeError):
@@ -217,18 +216,6 @@ def dominant_period(t: np.ndarray, x: np.ndarray) -> float:
     return float((tc[-1] - tc[0]) / (tc.size - 1))
 
 
-def _rec(case: str, quantity: str, measured: float, reference: float, tolerance: float) -> Record:
-    passed = bool(math.isfinite(measured) and abs(measured - reference) <= tolerance)
-    return dict(
-        case=case,
-        quantity=quantity,
-        measured=float(measured),
-        reference=float(reference),
-        tolerance=float(tolerance),
-        passed=passed,
-    )
-
-
 CASE = "fmu-fmpy-roundtrip"
 CASE_DESCRIPTION = (
     "FMI 3.0 co-simulation FMU of the slosh model: FMPy validates it and simulates it with tabulated tank motion "
@@ -239,8 +226,6 @@ CASE_DESCRIPTION = (
 
 def case_fmu_roundtrip(quick: bool) -> list[Record]:
     """The validation case ``fmu-fmpy-roundtrip`` (skipped without FMPy or an FMU)."""
-    from railslosh.validate import CaseSkipped
-
     try:
         from fmpy.validation import validate_fmu
     except ImportError as exc:
@@ -264,7 +249,7 @@ def roundtrip_records(fmu: str | Path, problems: list[str], quick: bool) -> list
     """Records of ``fmu-fmpy-roundtrip`` for an FMU (file or extracted directory) and its FMPy
     validation problems."""
     c = CASE
-    recs = [_rec(c, "FMPy validate_fmu problems", len(problems), 0, 0)]
+    recs = [within(c, "FMPy validate_fmu problems", len(problems), 0, 0)]
     rho, (L, a, b) = 1000.0, (SWRI["length"], SWRI["semi_axis_y"], SWRI["semi_axis_z"])
     m_ref = rho * 0.5 * math.pi * a * b * L
 
@@ -273,19 +258,19 @@ def roundtrip_records(fmu: str | Path, problems: list[str], quick: bool) -> list
     t = np.array([0.0, 0.5, 10.0])
     res = simulate(fmu, 10.0, tank_motion(t, a_y=[0.0, ay, ay], a_z=[0.0, az, az]), {"damping_ratio": 0.2})
     m = float(res["mass"][-1])
-    recs.append(_rec(c, "pendulum mass / (rho pi a b L / 2)", m / m_ref, 1.0, 1e-9))
-    recs.append(_rec(c, "steady F_y / (-m a_y)", res["F_y"][-1] / (-m * ay), 1.0, 1e-3))
-    recs.append(_rec(c, "steady F_z / (-m (g + a_z))", res["F_z"][-1] / (-m * (GRAVITY + az)), 1.0, 1e-3))
-    recs.append(_rec(c, "steady F_x / (m g)", res["F_x"][-1] / (m * GRAVITY), 0.0, 1e-6))
+    recs.append(within(c, "pendulum mass / (rho pi a b L / 2)", m / m_ref, 1.0, 1e-9))
+    recs.append(within(c, "steady F_y / (-m a_y)", res["F_y"][-1] / (-m * ay), 1.0, 1e-3))
+    recs.append(within(c, "steady F_z / (-m (g + a_z))", res["F_z"][-1] / (-m * (GRAVITY + az)), 1.0, 1e-3))
+    recs.append(within(c, "steady F_x / (m g)", res["F_x"][-1] / (m * GRAVITY), 0.0, 1e-6))
     mx = res["com_y"][-1] * res["F_z"][-1] - res["com_z"][-1] * res["F_y"][-1]
-    recs.append(_rec(c, "steady M_x / (com x F)_x", res["M_x"][-1] / mx, 1.0, 1e-3))
+    recs.append(within(c, "steady M_x / (com x F)_x", res["M_x"][-1] / mx, 1.0, 1e-3))
 
     # free lateral oscillation after a short pulse, undamped: period from the reported f_lateral
     t = np.array([0.0, 0.1, 0.1, 12.0])
     res = simulate(fmu, 12.0, tank_motion(t, a_y=[0.5, 0.5, 0.0, 0.0]), {"damping_ratio": 0.0}, output_interval=0.005)
     keep = res["time"] > 0.2
     period = dominant_period(res["time"][keep], res["F_y"][keep])
-    recs.append(_rec(c, "free oscillation f / f_lateral", 1.0 / period / res["f_lateral"][-1], 1.0, 0.01))
+    recs.append(within(c, "free oscillation f / f_lateral", 1.0 / period / res["f_lateral"][-1], 1.0, 0.01))
 
     # rollback: identical outputs after fmi3SetFMUState and after serialize/deserialize
     for model, params, t_save, t_end, h in [
@@ -293,8 +278,8 @@ def roundtrip_records(fmu: str | Path, problems: list[str], quick: bool) -> list
         ("ANCF", {"model": 1, "n_length": 1, "n_width": 2, "n_height": 1}, 0.02, 0.06, 0.01),
     ]:
         d = rollback_difference(fmu, params, t_save, t_end, h)
-        recs.append(_rec(c, f"{model} rollback max |output difference|", d["rollback"], 0.0, 0.0))
-        recs.append(_rec(c, f"{model} deserialized-state max |output difference|", d["serialized"], 0.0, 0.0))
+        recs.append(within(c, f"{model} rollback max |output difference|", d["rollback"], 0.0, 0.0))
+        recs.append(within(c, f"{model} deserialized-state max |output difference|", d["serialized"], 0.0, 0.0))
 
     if not quick:
         # ANCF water under a steady lateral acceleration: mean loads over the last second vs m (g - a)
@@ -304,10 +289,12 @@ def roundtrip_records(fmu: str | Path, problems: list[str], quick: bool) -> list
         res = simulate(fmu, 3.0, tank_motion(t, a_y=[0.0, ay, ay]), params, output_interval=0.02)
         m = float(res["mass"][-1])
         late = res["time"] >= 2.0
-        recs.append(_rec(c, "ANCF mass / (rho pi a b L / 2)", m / m_ref, 1.0, 0.01))
-        recs.append(_rec(c, "ANCF mean F_y / (-m a_y), t in [2, 3] s", np.mean(res["F_y"][late]) / (-m * ay), 1.0, 0.1))
+        recs.append(within(c, "ANCF mass / (rho pi a b L / 2)", m / m_ref, 1.0, 0.01))
         recs.append(
-            _rec(c, "ANCF mean F_z / (-m g), t in [2, 3] s", np.mean(res["F_z"][late]) / (-m * GRAVITY), 1.0, 0.02)
+            within(c, "ANCF mean F_y / (-m a_y), t in [2, 3] s", np.mean(res["F_y"][late]) / (-m * ay), 1.0, 0.1)
+        )
+        recs.append(
+            within(c, "ANCF mean F_z / (-m g), t in [2, 3] s", np.mean(res["F_z"][late]) / (-m * GRAVITY), 1.0, 0.02)
         )
     return recs
 

@@ -17,6 +17,8 @@ from typing import Any
 
 import numpy as np
 
+from railslosh.records import CaseSkipped, record
+
 SCENES = (
     "swri_lane_change_20mph",
     "swri_lane_change_40mph",
@@ -30,17 +32,6 @@ ENERGY_LIMIT = 0.05
 #: Peak-load change between the shipped and the refined mesh (issue 16 §4).
 CONVERGENCE_TOLERANCE = 0.05
 QUICK_T_END = 1.5
-
-
-def _record(case: str, quantity: str, measured: float, reference: float, tolerance: float, passed: bool) -> dict:
-    return {
-        "case": case,
-        "quantity": quantity,
-        "measured": float(measured),
-        "reference": float(reference),
-        "tolerance": float(tolerance),
-        "passed": bool(passed),
-    }
 
 
 def _run(sc: Any) -> tuple[dict, str | None]:
@@ -71,7 +62,6 @@ def _peak_load(res: dict) -> float:
 def swri_maneuvers(quick: bool) -> list[dict]:
     from railslosh import scene
     from railslosh.stress import _scenes_dir
-    from railslosh.validate import CaseSkipped
 
     case = "swri-maneuvers"
     d = _scenes_dir()
@@ -88,7 +78,7 @@ def swri_maneuvers(quick: bool) -> list[dict]:
         limit = _containment_limit(sc)
         what = f"{name} ({'x'.join(map(str, sc.fluid.counts))} mesh, t_end {sc.t_end:g} s)"
         out.append(
-            _record(
+            record(
                 case,
                 f"{what}: time reached (s){'; stopped: ' + err if err else ''}",
                 t_reached,
@@ -99,14 +89,14 @@ def swri_maneuvers(quick: bool) -> list[dict]:
         )
         gap = float(m.get("worst_gap", float("nan")))
         out.append(
-            _record(
+            record(
                 case, f"{what}: worst containment gap (m), limit half the smallest edge", gap, 0.0, limit, gap <= limit
             )
         )
         eps = m.get("worst_energy_error")
         eps = float("nan") if eps is None else float(eps)
         out.append(
-            _record(case, f"{what}: energy growth (E - E0 - W)/E_ref", eps, 0.0, ENERGY_LIMIT, eps <= ENERGY_LIMIT)
+            record(case, f"{what}: energy growth (E - E0 - W)/E_ref", eps, 0.0, ENERGY_LIMIT, eps <= ENERGY_LIMIT)
         )
         if quick:
             continue
@@ -117,7 +107,7 @@ def swri_maneuvers(quick: bool) -> list[dict]:
         peak, peak_fine = _peak_load(res), _peak_load(res_fine)
         change = abs(peak_fine - peak) / peak_fine if peak_fine > 0 else float("nan")
         out.append(
-            _record(
+            record(
                 case,
                 f"{what}: peak |load on the tank| after 0.2 s, change to the "
                 f"{'x'.join(map(str, fine.fluid.counts))} mesh "

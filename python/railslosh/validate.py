@@ -19,12 +19,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from railslosh import _core
-
-Record = dict[str, object]
-
-
-class CaseSkipped(Exception):
-    """A case could not run because its external reference data were not found (not a failure)."""
+from railslosh.records import CaseSkipped, Record
 
 
 @dataclass(frozen=True)

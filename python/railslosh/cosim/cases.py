@@ -18,34 +18,7 @@ from railslosh.cosim.centrifuge import (
 )
 from railslosh.cosim.emulators import PendulumSlosh, TankOnSprings, rectangular_tank
 from railslosh.cosim.masters import couple
-
-Record = dict[str, object]
-
-
-def _abs(case: str, quantity: str, measured: float, reference: float, tolerance: float) -> Record:
-    passed = bool(math.isfinite(measured) and abs(measured - reference) <= tolerance)
-    return dict(
-        case=case,
-        quantity=quantity,
-        measured=float(measured),
-        reference=float(reference),
-        tolerance=float(tolerance),
-        passed=passed,
-    )
-
-
-def _at_most(case: str, quantity: str, measured: float, limit: float) -> Record:
-    passed = bool(math.isfinite(measured) and abs(measured) <= limit)
-    return dict(
-        case=case, quantity=quantity, measured=float(measured), reference=0.0, tolerance=float(limit), passed=passed
-    )
-
-
-def _less_than(case: str, quantity: str, measured: float, limit: float) -> Record:
-    passed = bool(not math.isnan(measured) and measured < limit)
-    return dict(
-        case=case, quantity=quantity, measured=float(measured), reference=float(limit), tolerance=0.0, passed=passed
-    )
+from railslosh.records import Record, at_most, less_than, within
 
 
 def springs_pair(tank_mass: float = 2000.0):
@@ -78,7 +51,7 @@ def case_explicit_vs_monolithic(quick: bool) -> list[Record]:
     for scheme in ("explicit", "iqn-ils") if quick else ("explicit", "aitken", "iqn-ils"):
         errs = springs_errors(scheme, windows, t_end)
         recs.append(
-            _at_most(
+            at_most(
                 name,
                 f"{scheme}: max |q - q_mono| / max |q_mono|, tank on spring + rectangular-tank pendulum, "
                 f"window {windows[-1]} s, {t_end} s",
@@ -88,7 +61,7 @@ def case_explicit_vs_monolithic(quick: bool) -> list[Record]:
         )
         orders = [math.log2(errs[i] / errs[i + 1]) for i in range(len(errs) - 1)]
         recs.append(
-            _abs(
+            within(
                 name,
                 f"{scheme}: convergence order of that error, windows {windows[-2]} -> {windows[-1]} s",
                 orders[-1],
@@ -105,7 +78,7 @@ def case_centrifuge_added_mass(quick: bool) -> list[Record]:
     recs: list[Record] = []
     rc = critical_ratio(2)
     recs.append(
-        _abs(
+        within(
             name,
             "critical added-mass ratio m_a/m_t of explicit 3-sample extrapolation (root solve vs 1/7)",
             rc,
@@ -123,13 +96,11 @@ def case_centrifuge_added_mass(quick: bool) -> list[Record]:
                 f"explicit, steady spin, tank/liquid mass {f:g} x predicted threshold {mu_p:.3f}: "
                 "growth of the load oscillation"
             )
-            recs.append(
-                _less_than(name, q + " (> 10 = diverges)", -g, -10.0) if expect else _less_than(name, q, g, 10.0)
-            )
+            recs.append(less_than(name, q + " (> 10 = diverges)", -g, -10.0) if expect else less_than(name, q, g, 10.0))
     else:
         mu_m = measured_threshold(case, window=window, t_end=4.0, lo=2.0, hi=10.0, rel_tol=0.005)
         recs.append(
-            _abs(
+            within(
                 name,
                 f"explicit threshold tank/liquid mass ratio, steady spin, window {window} s: bisection vs linear "
                 "theory (r* = 1/7 at the steady added mass)",
@@ -140,7 +111,7 @@ def case_centrifuge_added_mass(quick: bool) -> list[Record]:
         )
         mu_s = measured_threshold(case, window=window, t_end=6.0, steady=False, lo=2.0, hi=10.0, rel_tol=0.005)
         recs.append(
-            _abs(
+            within(
                 name,
                 "explicit threshold with seed 003's spin-up (45 deg), window 0.01 s, vs linear theory",
                 mu_s,
@@ -152,7 +123,7 @@ def case_centrifuge_added_mass(quick: bool) -> list[Record]:
     t_end = 2.0 if quick else 6.0
     res = compare_schemes(case, mu_light, window=0.02 if quick else 0.01, t_end=t_end, rtol=1e-9)
     recs.append(
-        _abs(
+        within(
             name,
             f"explicit diverges with tank mass = liquid mass (1 = diverged), spin-up, {t_end} s",
             float(res["explicit"]["diverged"]),
@@ -162,7 +133,7 @@ def case_centrifuge_added_mass(quick: bool) -> list[Record]:
     )
     for scheme in ("aitken", "iqn-ils", "explicit+added-mass"):
         recs.append(
-            _at_most(
+            at_most(
                 name,
                 f"{scheme}, tank mass = liquid mass: max |s - s_mono| (m), spin-up, {t_end} s "
                 f"(s_max = {res['monolithic']['s_max']:.3f} m; mean iterations {res[scheme]['iterations']:.2f})",
