@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import railslosh as rs
-from railslosh import _core, constants, fluid_model, fluids, rail, stress
+from railslosh import _core, constants, fluid_model, fluids, rail, robustness
 from railslosh import fmu as rfmu
 from railslosh.cosim import emulators
 
@@ -20,7 +20,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def test_every_module_uses_the_one_standard_gravity():
     assert constants.GRAVITY == _core.GRAVITY == 9.80665
-    for g in (rail.GRAVITY, rfmu.GRAVITY, stress.G, fluid_model.G, emulators.GRAVITY):
+    for g in (rail.GRAVITY, rfmu.GRAVITY, robustness.G, fluid_model.G, emulators.GRAVITY):
         assert g == constants.GRAVITY
     assert (constants.FOOT, constants.INCH, constants.MPH) == (0.3048, 0.0254, 0.44704)
     assert inspect.signature(rs.slosh.run).parameters["gravity"].default == (0.0, 0.0, -constants.GRAVITY)

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from railslosh import cli, results, scene, slosh, stress
+from railslosh import cli, results, robustness, scene, slosh
 
 SCENES = Path(__file__).resolve().parents[1] / "examples" / "scenes"
 INVARIANT_CAUSES = {"containment", "distorted_element", "inverted_element", "energy_growth"}
@@ -39,7 +39,7 @@ def test_shortened_swri_scenes_keep_the_liquid_in_its_tank_with_balanced_energy(
     assert res["t"][-1] == pytest.approx(1.6)
     # independently of the run's own checks: the centre of mass never left the tank
     assert _inside_ellipse(sc, np.asarray(res["com_tank"]))
-    assert stress.silent_failure(res) == ""
+    assert robustness.silent_failure(res) == ""
     m = res["margins"]
     length, a, _ = sc.tank.dims
     nl, nw, nh = sc.fluid.counts
@@ -96,11 +96,11 @@ def test_the_stress_check_finds_a_liquid_outside_its_tank_in_a_finished_run():
     t = np.linspace(0.0, 1.0, 5)
     com = np.zeros((5, 3))
     com[3:, 2] = -0.44  # the 2026-11-24 run at 1.4 s: below the tank's bottom (b = 0.132 m)
-    msg = stress.silent_failure({"t": t, "com_tank": com, "scene": sc})
+    msg = robustness.silent_failure({"t": t, "com_tank": com, "scene": sc})
     assert msg.startswith("centre of mass outside the tank at t = 0.750 s"), msg
-    assert stress.silent_failure({"t": t, "com_tank": np.zeros((5, 3)), "scene": sc}) == ""
+    assert robustness.silent_failure({"t": t, "com_tank": np.zeros((5, 3)), "scene": sc}) == ""
     grown = {"t": t, "com_tank": np.zeros((5, 3)), "scene": sc, "energy_error": np.array([0, 0, 0.2, 0, 0])}
-    assert "energy grew" in stress.silent_failure(grown)
+    assert "energy grew" in robustness.silent_failure(grown)
 
 
 def test_a_vehicle_run_reports_its_invariant_margins(tmp_path):

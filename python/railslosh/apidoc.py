@@ -22,7 +22,7 @@ MODULES = (
     "railslosh.report",
     "railslosh.sweep",
     "railslosh.bench",
-    "railslosh.stress",
+    "railslosh.robustness",
     "railslosh.cosim",
     "railslosh.fmu",
     "railslosh.cli",

@@ -370,9 +370,9 @@ def build_parser() -> argparse.ArgumentParser:
     sw.add_argument("-o", "--out", help="output directory (default out/sweep_<scene name>)")
     sw.set_defaults(func=_cmd_sweep)
 
-    from railslosh import stress
+    from railslosh import robustness
 
-    stress.add_subparser(sub)
+    robustness.add_subparser(sub)
     return p
 
 

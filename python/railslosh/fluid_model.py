@@ -47,13 +47,16 @@ __all__ = [
     "EXCITATION_THRESHOLD",
     "FLUID_MODELS",
     "RISE_LIMIT_FRACTION",
+    "SLOSH_MODELS",
     "FluidModelChoice",
     "choose_fluid_model",
     "decide",
 ]
 
-FLUID_MODELS = ("auto", "ancf", "pendulum", "rigid")
-"""Values of ``[fluid] slosh_model``."""
+SLOSH_MODELS = ("auto", "ancf", "pendulum", "rigid")
+"""Values of ``[fluid] slosh_model`` (the model of the liquid in a vehicle run)."""
+FLUID_MODELS = SLOSH_MODELS
+"""Deprecated alias of :data:`SLOSH_MODELS` (one release)."""
 EXCITATION_THRESHOLD = 0.1
 """m/s^2: an axis whose estimated acceleration is at most this is not excited."""
 DYNAMIC_FACTOR = 2.0

@@ -86,6 +86,7 @@ import numpy as np
 
 from railslosh import rail, vehicle
 from railslosh.constants import ARC_DEGREE_RADIUS_FT, FOOT, GRAVITY, INCH, MPH
+from railslosh.fluid_model import SLOSH_MODELS
 
 __all__ = [
     "OILS",
@@ -138,8 +139,7 @@ _MAX_ROWS = 10_000
 _SECTIONS = ("track", "train", "brake", "lading", "car", "scene", "fluid", "mesh", "tank", "outputs")
 OILS = ("light", "medium", "heavy", "water", "custom")
 """Names accepted by ``[fluid] oil``."""
-_FLUID_MODELS = ("newtonian", "bingham", "herschel-bulkley", "oldroyd", "casson")
-SLOSH_MODELS = ("auto", "ancf", "pendulum", "rigid")
+_RHEOLOGIES = ("newtonian", "bingham", "herschel-bulkley", "oldroyd", "casson")
 """Values of ``[fluid] slosh_model`` (see :mod:`railslosh.fluid_model`)."""
 _WHEEL_PROFILES = ("s1002", "aar1b")
 _BRAKE_SCOPES = ("all", "front")
@@ -748,7 +748,7 @@ def _fluid_section(fl: Mapping[str, Any]) -> tuple[str, dict[str, Any]]:
     if oil == "custom":
         if "model" not in fl or "density" not in fl:
             raise _fail("fluid.model" if "model" not in fl else "fluid.density", None, 'given with oil = "custom"')
-        custom["model"] = _choice(fl["model"], "fluid.model", _FLUID_MODELS)
+        custom["model"] = _choice(fl["model"], "fluid.model", _RHEOLOGIES)
         for k, (lo, hi, unit) in _CUSTOM_KEYS.items():
             if k in fl:
                 custom[k] = _number(fl[k], f"fluid.{k}", lo, hi, unit)

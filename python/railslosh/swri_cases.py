@@ -61,7 +61,7 @@ def _peak_load(res: dict) -> float:
 
 def swri_maneuvers(quick: bool) -> list[dict]:
     from railslosh import scene
-    from railslosh.stress import _scenes_dir
+    from railslosh.robustness import _scenes_dir
 
     case = "swri-maneuvers"
     d = _scenes_dir()

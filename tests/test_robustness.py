@@ -1,6 +1,6 @@
 """Robustness (issue 8): the quick stress matrix has no silent failures, failures are typed and
 keep their partial results, runs are bitwise reproducible with any thread count, and a
-malformed profile file gives a clear error. The full matrix is ``railslosh stress --full``
+malformed profile file gives a clear error. The full matrix is ``railslosh robustness --full``
 (docs/robustness.md)."""
 
 import json
@@ -12,7 +12,7 @@ import time
 import numpy as np
 import pytest
 
-from railslosh import cli, fluids, mesh, rail, slosh, stress
+from railslosh import cli, fluids, mesh, rail, robustness, slosh
 
 BOX = (0.416, 0.324, 0.132)
 TANK = slosh.box_tank((-0.208, -0.162, 0.0), (0.208, 0.162, 0.3))
@@ -20,7 +20,7 @@ TANK = slosh.box_tank((-0.208, -0.162, 0.0), (0.208, 0.162, 0.3))
 
 @pytest.fixture(scope="module")
 def quick_table():
-    return stress.run_matrix(stress.cases("quick"))
+    return robustness.run_matrix(robustness.cases("quick"))
 
 
 def test_quick_matrix_covers_every_axis(quick_table):
@@ -59,9 +59,9 @@ def test_quick_matrix_has_no_silent_failures(quick_table):
     assert sum(counts.values()) == len(quick_table["rows"])
     for r in quick_table["rows"]:
         if r["outcome"] == "ok":
-            assert r["volume_error"] <= stress.VOLUME_TOLERANCE
+            assert r["volume_error"] <= robustness.VOLUME_TOLERANCE
         elif r["outcome"] == "typed_error":
-            assert r["cause"] in {name for name, _ in stress.CAUSES}
+            assert r["cause"] in {name for name, _ in robustness.CAUSES}
             assert r["samples"] >= 1, r
 
 
@@ -138,7 +138,7 @@ def test_deep_wall_penetration_stops_with_a_typed_error():
     ],
 )  # fmt: skip
 def test_failure_messages_map_to_causes(message, cause):
-    assert stress.classify(message) == cause
+    assert robustness.classify(message) == cause
     assert slosh.SimulationError(message, {}).cause == cause
 
 
@@ -198,11 +198,11 @@ def test_malformed_profile_files_give_clear_errors(tmp_path):
 
 def test_cli_stress_writes_the_table(tmp_path, monkeypatch, capsys):
     # The CLI on a two-case matrix (the quick matrix itself is tested above).
-    small = [c for c in stress.cases("quick") if c.kind == "vehicle"][:1]
-    small.append(stress._slosh("viscosity", 1e-3, t_end=0.05))
-    monkeypatch.setattr(stress, "cases", lambda form: small)
+    small = [c for c in robustness.cases("quick") if c.kind == "vehicle"][:1]
+    small.append(robustness._slosh("viscosity", 1e-3, t_end=0.05))
+    monkeypatch.setattr(robustness, "cases", lambda form: small)
     out_json, out_csv = tmp_path / "s.json", tmp_path / "s.csv"
-    assert cli.main(["stress", "--json", str(out_json), "--csv", str(out_csv)]) == 0
+    assert cli.main(["robustness", "--json", str(out_json), "--csv", str(out_csv)]) == 0
     summary = json.loads(capsys.readouterr().out)
     assert summary["counts"] == {"ok": 2, "typed_error": 0, "rejected": 0, "bug": 0}
     table = json.loads(out_json.read_text())
@@ -271,6 +271,19 @@ slosh.run(mesh.box({BOX!r}, (2, 3, 2)), fluids.water(depth=0.132), tank, motion,
 def test_the_matrix_builds_the_herschel_bulkley_fluid_its_case_names():
     """The yield-stress, power-index and rheology cases vary the law they name (an earlier
     positional call passed tau0 as the consistency and mu as the power index)."""
-    f = stress._fluid({"penalty_factor": 1.0, "viscosity": 0.1, "yield_stress": 1000.0, "power_index": 0.5}, 0.1)
+    f = robustness._fluid({"penalty_factor": 1.0, "viscosity": 0.1, "yield_stress": 1000.0, "power_index": 0.5}, 0.1)
     assert f.model == "herschel-bulkley" and f.yield_stress == 1000.0
     assert "consistency: 0.1," in repr(f) and "power_index: 0.5," in repr(f)
+
+
+def test_the_old_stress_names_still_work_for_one_release():
+    """``railslosh.stress`` and ``railslosh stress`` are deprecated aliases of the robustness matrix."""
+    import importlib
+    import sys
+
+    sys.modules.pop("railslosh.stress", None)
+    with pytest.warns(DeprecationWarning, match="railslosh.robustness"):
+        old = importlib.import_module("railslosh.stress")
+    assert old is robustness
+    parser = cli.build_parser()
+    assert parser.parse_args(["stress"]).func is parser.parse_args(["robustness"]).func
