@@ -21,14 +21,13 @@
 
 use std::ops::Range;
 
-use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::sparse::linalg::LuError;
 use faer::sparse::linalg::lu::{LuRef, NumericLu, SymbolicLu, factorize_symbolic_lu};
 use faer::sparse::{Pair, SparseColMat, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par};
 use rayon::prelude::*;
 
-use super::linear::LinearFailure;
+use super::linear::{LinearFailure, Scratch};
 
 const NONE: usize = usize::MAX;
 
@@ -39,8 +38,7 @@ struct SubLu {
     gather: Vec<(usize, usize)>,
     symbolic: SymbolicLu<usize>,
     numeric: NumericLu<usize, f64>,
-    req: StackReq,
-    buffer: MemBuffer,
+    scratch: Scratch,
     /// Full-matrix index of each sub-matrix row and column (for error messages).
     global: Vec<usize>,
 }
@@ -60,8 +58,7 @@ impl SubLu {
             gather: Vec::new(),
             symbolic,
             numeric: NumericLu::new(),
-            req: StackReq::EMPTY,
-            buffer: MemBuffer::new(StackReq::EMPTY),
+            scratch: Scratch::new(),
             global,
         })
     }
@@ -72,15 +69,6 @@ impl SubLu {
         let start = sym.col_ptr()[col];
         let rows = &sym.row_idx()[start..sym.col_ptr()[col + 1]];
         start + rows.binary_search(&row).expect("entry in the sub-matrix pattern")
-    }
-
-    fn stack(&mut self, req: StackReq) -> Result<&mut MemStack, LinearFailure> {
-        let grown = self.req.or(req);
-        if grown != self.req {
-            self.buffer = MemBuffer::try_new(grown).map_err(|e| LinearFailure::Generic(format!("{e:?}")))?;
-            self.req = grown;
-        }
-        Ok(MemStack::new(&mut self.buffer))
     }
 
     /// Gathers the values from the full matrix (`extra` is added after: the Schur update).
@@ -100,12 +88,7 @@ impl SubLu {
         let symbolic = &self.symbolic;
         let matrix = self.matrix.as_ref();
         let numeric = &mut self.numeric;
-        let grown = self.req.or(req);
-        if grown != self.req {
-            self.buffer = MemBuffer::try_new(grown).map_err(|e| LinearFailure::Generic(format!("{e:?}")))?;
-            self.req = grown;
-        }
-        let stack = MemStack::new(&mut self.buffer);
+        let stack = self.scratch.stack(req)?;
         // faer 0.24 can panic on some zero pivots (faer-rs issue #232), as in the direct backend
         let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
             symbolic.factorize_numeric_lu(numeric, matrix, Par::Seq, stack, Default::default()).map(|_| ())
@@ -128,8 +111,7 @@ impl SubLu {
     fn solve(&mut self, x: &mut [f64], ncols: usize) -> Result<(), LinearFailure> {
         let dim = self.global.len();
         let req = self.symbolic.solve_in_place_scratch::<f64>(ncols, Par::Seq);
-        self.stack(req)?;
-        let stack = MemStack::new(&mut self.buffer);
+        let stack = self.scratch.stack(req)?;
         let lu = LuRef::new_unchecked(&self.symbolic, &self.numeric);
         lu.solve_in_place_with_conj(Conj::No, MatMut::from_column_major_slice_mut(x, dim, ncols), Par::Seq, stack);
         ancf_core::clear_upper_simd();

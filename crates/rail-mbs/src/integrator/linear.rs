@@ -59,18 +59,18 @@ pub(crate) struct KktSolver {
 }
 
 /// A reusable faer scratch buffer that grows to the largest requirement seen.
-struct Scratch {
+pub(crate) struct Scratch {
     req: StackReq,
     buffer: MemBuffer,
 }
 
 impl Scratch {
-    fn new() -> Self {
+    pub(crate) fn new() -> Self {
         Self { req: StackReq::EMPTY, buffer: MemBuffer::new(StackReq::EMPTY) }
     }
 
     /// A stack of at least `req`; allocates only when `req` exceeds every earlier one.
-    fn stack(&mut self, req: StackReq) -> Result<&mut MemStack, LinearFailure> {
+    pub(crate) fn stack(&mut self, req: StackReq) -> Result<&mut MemStack, LinearFailure> {
         let grown = self.req.or(req);
         if grown != self.req {
             self.buffer = MemBuffer::try_new(grown).map_err(|e| LinearFailure::Generic(format!("{e:?}")))?;
