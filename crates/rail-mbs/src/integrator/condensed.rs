@@ -53,14 +53,7 @@ impl SubLu {
         let matrix = SparseColMat::new(symbolic, vec![0.0; nnz]);
         let symbolic = factorize_symbolic_lu(matrix.symbolic(), Default::default())
             .map_err(|e| LinearFailure::Generic(format!("{e:?}")))?;
-        Ok(Self {
-            matrix,
-            gather: Vec::new(),
-            symbolic,
-            numeric: NumericLu::new(),
-            scratch: Scratch::new(),
-            global,
-        })
+        Ok(Self { matrix, gather: Vec::new(), symbolic, numeric: NumericLu::new(), scratch: Scratch::new(), global })
     }
 
     /// Value position of (row, col), which must be in the pattern.
