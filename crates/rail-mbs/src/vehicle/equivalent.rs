@@ -71,16 +71,12 @@
 //! `Σ m₀ x_c / M_total` (zero for symmetric ones). The liquid has no roll inertia about
 //! the axis (inviscid: notes §3), beyond `m₀ z₀²` of the lading.
 
-use std::time::Instant;
-
 use ancf_core::error::{AncfError, check_positive, invalid};
 use ancf_core::mesh::CylinderTankSpec;
 use ancf_core::{Fluid, Rheology};
 use nalgebra::{Matrix3, Vector3};
 
-use super::run::{
-    Observer, RecordEvent, SampleSink, TrainRecord, TrainScenario, build_train, record_sample, step_and_record,
-};
+use super::run::{Observer, SampleSink, TrainRecord, TrainRun, TrainScenario, build_train, drive, record_sample};
 use super::tank_car::CarBodies;
 use crate::integrator::{Hht, IntegratorError};
 use crate::mbs::{BodyId, Bushing, Multibody, RigidBody};
@@ -723,71 +719,67 @@ pub fn run_equivalent_train_streamed(
     sc: &TrainScenario,
     cargo: &EquivalentCargo,
     observe: Observer<'_>,
-    mut sink: Option<SampleSink<'_>>,
+    sink: Option<SampleSink<'_>>,
 ) -> Result<Result<EquivalentTrainRecord, Box<EquivalentTrainFailure>>, AncfError> {
     let built = build_equivalent_train(sc, cargo)?;
     let EquivalentTrain { mb, cars, couplers, slosh, model, tank_origin_height } = built;
-    let mut rec = EquivalentTrainRecord {
+    let rec = EquivalentTrainRecord {
         train: TrainRecord { static_wheel_load: cars[0].static_wheel_load, dof: mb.dof(), ..Default::default() },
         model: Some(model.clone()),
         ..Default::default()
     };
-    let (q0, v0) = mb.initial_coordinates();
-    let start = Instant::now();
-    let finish = |hht: Option<&Hht<Multibody>>, mut rec: EquivalentTrainRecord| {
-        rec.train.finish(hht.map(|h| h.stats()), start);
-        rec
-    };
-    let mut hht = match Hht::new(mb, 0.0, q0, v0, sc.hht) {
-        Ok(h) => h,
-        Err(error) => return Ok(Err(Box::new(EquivalentTrainFailure { error, record: finish(None, rec) }))),
-    };
-    let mut hints: Vec<f64> = cars.iter().flat_map(|c| [c.station; 4]).collect();
-    let mut scratch = TrainRecord::default();
-    let result = step_and_record(&mut hht, sc, observe, |hht, event| {
-        let (t, q, v) = (hht.t(), hht.q().to_vec(), hht.v().to_vec());
-        match event {
-            RecordEvent::Sample(_) => {
-                record_sample(
-                    hht.system_observed(),
-                    (t, &q, &v),
-                    &sc.track,
-                    &cars,
-                    &couplers,
-                    &mut hints,
-                    &mut rec.train,
-                )?;
-                record_equivalent(hht.system(), (&cars, &slosh, &model, tank_origin_height), &q, &mut rec);
-                Ok(())
-            }
-            RecordEvent::Loads(out) => {
-                scratch.clear_samples();
-                record_sample(
-                    hht.system_observed(),
-                    (t, &q, &v),
-                    &sc.track,
-                    &cars,
-                    &couplers,
-                    &mut hints,
-                    &mut scratch,
-                )?;
-                out.clear();
-                scratch.loads_into(0, out);
-                Ok(())
-            }
-            RecordEvent::Finish(k, loads) => {
-                if let Some(l) = loads {
-                    rec.train.set_loads(k, l);
-                }
-                match sink.as_mut() {
-                    Some(sink) => sink(&rec.row(k)),
-                    None => Ok(()),
-                }
-            }
-        }
-    });
-    if let Err(error) = result {
-        return Ok(Err(Box::new(EquivalentTrainFailure { error, record: finish(Some(&hht), rec) })));
+    let init = mb.initial_coordinates();
+    let hints = cars.iter().flat_map(|c| [c.station; 4]).collect();
+    let run = EquivalentRun { sc, cars, couplers, slosh, model, tank_origin_height, hints };
+    Ok(drive(run, mb, init, sc, observe, sink, rec)
+        .map_err(|(error, record)| Box::new(EquivalentTrainFailure { error, record })))
+}
+
+/// The equivalent-model run ([`run_equivalent_train`]): the vehicle channels and the slosh
+/// masses' (the load filter needs the vehicle's only).
+struct EquivalentRun<'a> {
+    sc: &'a TrainScenario,
+    cars: Vec<CarBodies>,
+    couplers: Vec<usize>,
+    slosh: Vec<Vec<BodyId>>,
+    model: EquivalentModel,
+    tank_origin_height: f64,
+    /// Warm starts of the wheel/rail search at the recorded samples.
+    hints: Vec<f64>,
+}
+
+impl TrainRun for EquivalentRun<'_> {
+    type System = Multibody;
+    type Record = EquivalentTrainRecord;
+    fn train(rec: &mut EquivalentTrainRecord) -> &mut TrainRecord {
+        &mut rec.train
     }
-    Ok(Ok(finish(Some(&hht), rec)))
+    fn sample(
+        &mut self,
+        hht: &mut Hht<Multibody>,
+        _k: usize,
+        rec: &mut EquivalentTrainRecord,
+        full: bool,
+    ) -> Result<(), IntegratorError> {
+        let (t, q, v) = (hht.t(), hht.q().to_vec(), hht.v().to_vec());
+        let mb = hht.system_observed();
+        record_sample(mb, (t, &q, &v), &self.sc.track, &self.cars, &self.couplers, &mut self.hints, &mut rec.train)?;
+        if full {
+            let parts = (self.cars.as_slice(), self.slosh.as_slice(), &self.model, self.tank_origin_height);
+            record_equivalent(hht.system(), parts, &q, rec);
+        }
+        Ok(())
+    }
+    fn clear_samples(rec: &mut EquivalentTrainRecord) {
+        rec.train.clear_samples();
+    }
+    fn loads_into(rec: &EquivalentTrainRecord, i: usize, out: &mut Vec<f64>) {
+        rec.train.loads_into(i, out);
+    }
+    fn set_loads(rec: &mut EquivalentTrainRecord, i: usize, loads: &[f64]) {
+        rec.train.set_loads(i, loads);
+    }
+    fn row(rec: &EquivalentTrainRecord, i: usize) -> Vec<f64> {
+        rec.row(i)
+    }
 }

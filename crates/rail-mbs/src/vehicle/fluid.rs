@@ -526,11 +526,8 @@ use ancf_core::contact::WallContactLaw;
 use ancf_core::element::QuadratureOptions;
 use ancf_core::mesh::{CylinderTankSpec, cylinder_tank, cylinder_tank_compartments};
 use ancf_core::tank::{Bulkhead, TankGeometry, TankShape};
-use std::time::Instant;
 
-use super::run::{
-    Observer, RecordEvent, SampleSink, TrainRecord, TrainScenario, build_train, record_sample, step_and_record,
-};
+use super::run::{Observer, SampleSink, TrainRecord, TrainRun, TrainScenario, build_train, drive, record_sample};
 use super::tank_car::CarBodies;
 use crate::integrator::{Hht, IntegratorError};
 
@@ -798,7 +795,7 @@ pub fn run_fluid_train_streamed(
     sc: &TrainScenario,
     cargo: &FluidCargo,
     observe: Observer<'_>,
-    mut sink: Option<SampleSink<'_>>,
+    sink: Option<SampleSink<'_>>,
 ) -> Result<Result<FluidTrainRecord, Box<FluidTrainFailure>>, AncfError> {
     let (sys, cars, couplers) = build_fluid_train(sc, cargo)?;
     let mut rec = FluidTrainRecord {
@@ -809,70 +806,66 @@ pub fn run_fluid_train_streamed(
     };
     rec.train.static_wheel_load = cars[0].static_wheel_load;
     rec.train.dof = sys.mb.dof() + sys.fluids.iter().map(|f| f.body.n_coords() as isize).sum::<isize>();
-    let nr = sys.mb.n_coords();
-    let (q0, v0) = sys.initial_coordinates();
-    let start = Instant::now();
-    let finish = |hht: Option<&Hht<FluidVehicle>>, mut rec: FluidTrainRecord| {
-        rec.train.finish(hht.map(|h| h.stats()), start);
-        if let Some(h) = hht {
-            rec.margins = h.system().margins();
-        }
-        rec
-    };
-    let mut hht = match Hht::new(sys, 0.0, q0, v0, sc.hht) {
-        Ok(h) => h,
-        Err(error) => return Ok(Err(Box::new(FluidTrainFailure { error, record: finish(None, rec) }))),
-    };
-    let mut hints: Vec<f64> = cars.iter().flat_map(|c| [c.station; 4]).collect();
-    let mut scratch = FluidTrainRecord::default();
-    let result = step_and_record(&mut hht, sc, observe, |hht, event| {
-        let (t, q, v) = (hht.t(), hht.q().to_vec(), hht.v().to_vec());
-        match event {
-            RecordEvent::Sample(k) => {
-                let sys = hht.system_observed();
-                record_sample(
-                    &mut sys.mb,
-                    (t, &q[..nr], &v[..nr]),
-                    &sc.track,
-                    &cars,
-                    &couplers,
-                    &mut hints,
-                    &mut rec.train,
-                )?;
-                record_fluid(hht.system(), &q, &v, &mut rec);
-                if sc.snapshot_every > 0.0 {
-                    let every = (sc.snapshot_every / sc.record_every).round().max(1.0) as usize;
-                    if k % every == 0 {
-                        let sys = hht.system();
-                        let e = (0..sys.fluids.len()).map(|f| sys.fluid_slice(f, &q).to_vec()).collect();
-                        rec.snapshots.push((t, e));
-                    }
-                }
-                Ok(())
-            }
-            RecordEvent::Loads(out) => {
-                scratch.clear_samples();
-                let sys = hht.system_observed();
-                let state = (t, &q[..nr], &v[..nr]);
-                record_sample(&mut sys.mb, state, &sc.track, &cars, &couplers, &mut hints, &mut scratch.train)?;
-                record_fluid(hht.system(), &q, &v, &mut scratch);
-                out.clear();
-                scratch.loads_into(0, out);
-                Ok(())
-            }
-            RecordEvent::Finish(k, loads) => {
-                if let Some(l) = loads {
-                    rec.set_loads(k, l);
-                }
-                match sink.as_mut() {
-                    Some(sink) => sink(&rec.row(k)),
-                    None => Ok(()),
-                }
-            }
-        }
-    });
-    if let Err(error) = result {
-        return Ok(Err(Box::new(FluidTrainFailure { error, record: finish(Some(&hht), rec) })));
+    let init = sys.initial_coordinates();
+    let hints = cars.iter().flat_map(|c| [c.station; 4]).collect();
+    let run = FluidRun { sc, nr: sys.mb.n_coords(), cars, couplers, hints };
+    Ok(drive(run, sys, init, sc, observe, sink, rec)
+        .map_err(|(error, record)| Box::new(FluidTrainFailure { error, record })))
+}
+
+/// The ANCF-fluid run ([`run_fluid_train`]): the vehicle channels, each fluid's, and snapshots.
+struct FluidRun<'a> {
+    sc: &'a TrainScenario,
+    /// Rigid coordinates (the fluids follow).
+    nr: usize,
+    cars: Vec<CarBodies>,
+    couplers: Vec<usize>,
+    /// Warm starts of the wheel/rail search at the recorded samples.
+    hints: Vec<f64>,
+}
+
+impl TrainRun for FluidRun<'_> {
+    type System = FluidVehicle;
+    type Record = FluidTrainRecord;
+    fn train(rec: &mut FluidTrainRecord) -> &mut TrainRecord {
+        &mut rec.train
     }
-    Ok(Ok(finish(Some(&hht), rec)))
+    fn sample(
+        &mut self,
+        hht: &mut Hht<FluidVehicle>,
+        k: usize,
+        rec: &mut FluidTrainRecord,
+        full: bool,
+    ) -> Result<(), IntegratorError> {
+        let (t, q, v) = (hht.t(), hht.q().to_vec(), hht.v().to_vec());
+        let (nr, sc) = (self.nr, self.sc);
+        let sys = hht.system_observed();
+        let state = (t, &q[..nr], &v[..nr]);
+        record_sample(&mut sys.mb, state, &sc.track, &self.cars, &self.couplers, &mut self.hints, &mut rec.train)?;
+        record_fluid(hht.system(), &q, &v, rec);
+        if full && sc.snapshot_every > 0.0 {
+            let every = (sc.snapshot_every / sc.record_every).round().max(1.0) as usize;
+            if k.is_multiple_of(every) {
+                let sys = hht.system();
+                let e = (0..sys.fluids.len()).map(|f| sys.fluid_slice(f, &q).to_vec()).collect();
+                rec.snapshots.push((t, e));
+            }
+        }
+        Ok(())
+    }
+    fn clear_samples(rec: &mut FluidTrainRecord) {
+        rec.clear_samples();
+    }
+    fn loads_into(rec: &FluidTrainRecord, i: usize, out: &mut Vec<f64>) {
+        rec.loads_into(i, out);
+    }
+    fn set_loads(rec: &mut FluidTrainRecord, i: usize, loads: &[f64]) {
+        rec.set_loads(i, loads);
+    }
+    fn row(rec: &FluidTrainRecord, i: usize) -> Vec<f64> {
+        rec.row(i)
+    }
+    fn finish(hht: &Hht<FluidVehicle>, rec: &mut FluidTrainRecord) {
+        rec.margins = hht.system().margins();
+    }
 }

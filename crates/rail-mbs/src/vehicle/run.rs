@@ -545,6 +545,132 @@ pub(crate) fn step_and_record<S: crate::integrator::MechanicalSystem>(
     result
 }
 
+/// What one kind of train run (rigid lading, equivalent slosh model, ANCF fluid) records: its
+/// record and how it samples the vehicle and its cargo. [`drive`] is the one run loop over
+/// every kind.
+pub(crate) trait TrainRun {
+    /// The system the integrator steps.
+    type System: crate::integrator::MechanicalSystem;
+    /// The run's results (samples plus run data).
+    type Record: Default;
+    /// The vehicle part of a record.
+    fn train(rec: &mut Self::Record) -> &mut TrainRecord;
+    /// Records the state of `hht` as a sample of `rec` (`k`: its index); `full` is false for
+    /// the load-filter pass, which needs the load channels only.
+    fn sample(
+        &mut self,
+        hht: &mut Hht<Self::System>,
+        k: usize,
+        rec: &mut Self::Record,
+        full: bool,
+    ) -> Result<(), IntegratorError>;
+    /// Empties the samples of a scratch record.
+    fn clear_samples(rec: &mut Self::Record);
+    /// The load channels of sample `i`.
+    fn loads_into(rec: &Self::Record, i: usize, out: &mut Vec<f64>);
+    /// Replaces the load channels of sample `i`.
+    fn set_loads(rec: &mut Self::Record, i: usize, loads: &[f64]);
+    /// Sample `i` as one results-stream row.
+    fn row(rec: &Self::Record, i: usize) -> Vec<f64>;
+    /// Run data taken from the integrator at the end (e.g. the fluids' margins).
+    fn finish(_hht: &Hht<Self::System>, _rec: &mut Self::Record) {}
+}
+
+/// The run loop of every train run: builds the integrator on `sys` from `(q0, v0)`, steps and
+/// records through [`step_and_record`], streams each finished sample to `sink`, and returns
+/// the record, or the error with everything recorded up to it.
+pub(crate) fn drive<R: TrainRun>(
+    mut run: R,
+    sys: R::System,
+    (q0, v0): (Vec<f64>, Vec<f64>),
+    sc: &TrainScenario,
+    observe: Observer<'_>,
+    mut sink: Option<SampleSink<'_>>,
+    mut rec: R::Record,
+) -> Result<R::Record, (IntegratorError, R::Record)> {
+    let start = Instant::now();
+    let mut hht = match Hht::new(sys, 0.0, q0, v0, sc.hht) {
+        Ok(h) => h,
+        Err(error) => {
+            R::train(&mut rec).finish(None, start);
+            return Err((error, rec));
+        }
+    };
+    let mut scratch = R::Record::default();
+    let result = step_and_record(&mut hht, sc, observe, |hht, event| match event {
+        RecordEvent::Sample(k) => run.sample(hht, k, &mut rec, true),
+        RecordEvent::Loads(out) => {
+            R::clear_samples(&mut scratch);
+            run.sample(hht, 0, &mut scratch, false)?;
+            out.clear();
+            R::loads_into(&scratch, 0, out);
+            Ok(())
+        }
+        RecordEvent::Finish(k, loads) => {
+            if let Some(l) = loads {
+                R::set_loads(&mut rec, k, l);
+            }
+            match sink.as_mut() {
+                Some(sink) => sink(&R::row(&rec, k)),
+                None => Ok(()),
+            }
+        }
+    });
+    R::train(&mut rec).finish(Some(hht.stats()), start);
+    R::finish(&hht, &mut rec);
+    match result {
+        Ok(()) => Ok(rec),
+        Err(error) => Err((error, rec)),
+    }
+}
+
+/// The rigid-lading run ([`run_train`]): the vehicle channels only.
+struct RigidRun<'a> {
+    sc: &'a TrainScenario,
+    cars: Vec<CarBodies>,
+    couplers: Vec<usize>,
+    /// Warm starts of the wheel/rail search at the recorded samples.
+    hints: Vec<f64>,
+}
+
+impl TrainRun for RigidRun<'_> {
+    type System = Multibody;
+    type Record = TrainRecord;
+    fn train(rec: &mut TrainRecord) -> &mut TrainRecord {
+        rec
+    }
+    fn sample(
+        &mut self,
+        hht: &mut Hht<Multibody>,
+        _k: usize,
+        rec: &mut TrainRecord,
+        _full: bool,
+    ) -> Result<(), IntegratorError> {
+        let (t, q, v) = (hht.t(), hht.q().to_vec(), hht.v().to_vec());
+        record_sample(
+            hht.system_observed(),
+            (t, &q, &v),
+            &self.sc.track,
+            &self.cars,
+            &self.couplers,
+            &mut self.hints,
+            rec,
+        )
+    }
+    fn clear_samples(rec: &mut TrainRecord) {
+        rec.clear_samples();
+    }
+    fn loads_into(rec: &TrainRecord, i: usize, out: &mut Vec<f64>) {
+        rec.loads_into(i, out);
+    }
+    fn set_loads(rec: &mut TrainRecord, i: usize, loads: &[f64]) {
+        rec.set_loads(i, loads);
+    }
+    fn row(rec: &TrainRecord, i: usize) -> Vec<f64> {
+        rec.row(i)
+    }
+}
+
 /// Runs a scenario; on failure returns what was recorded so far with the error.
 pub fn run_train(sc: &TrainScenario) -> Result<Result<TrainRecord, Box<TrainFailure>>, AncfError> {
     run_train_observed(sc, &mut |_| true)
@@ -567,58 +693,14 @@ pub fn run_train_observed(
 pub fn run_train_streamed(
     sc: &TrainScenario,
     observe: Observer<'_>,
-    mut sink: Option<SampleSink<'_>>,
+    sink: Option<SampleSink<'_>>,
 ) -> Result<Result<TrainRecord, Box<TrainFailure>>, AncfError> {
     let (mb, cars, couplers) = build_train(sc)?;
-    let mut rec = TrainRecord { static_wheel_load: cars[0].static_wheel_load, dof: mb.dof(), ..Default::default() };
-    let (q0, v0) = mb.initial_coordinates();
-    let start = Instant::now();
-    let finish = |hht: Option<&Hht<Multibody>>, mut rec: TrainRecord| {
-        rec.finish(hht.map(|h| h.stats()), start);
-        rec
-    };
-    let mut hht = match Hht::new(mb, 0.0, q0, v0, sc.hht) {
-        Ok(h) => h,
-        Err(error) => return Ok(Err(Box::new(TrainFailure { error, record: finish(None, rec) }))),
-    };
-    let mut hints: Vec<f64> = cars.iter().flat_map(|c| [c.station; 4]).collect();
-    let mut scratch = TrainRecord::default();
-    let result = step_and_record(&mut hht, sc, observe, |hht, event| {
-        let (t, q, v) = (hht.t(), hht.q().to_vec(), hht.v().to_vec());
-        match event {
-            RecordEvent::Sample(_) => {
-                record_sample(hht.system_observed(), (t, &q, &v), &sc.track, &cars, &couplers, &mut hints, &mut rec)
-            }
-            RecordEvent::Loads(out) => {
-                scratch.clear_samples();
-                record_sample(
-                    hht.system_observed(),
-                    (t, &q, &v),
-                    &sc.track,
-                    &cars,
-                    &couplers,
-                    &mut hints,
-                    &mut scratch,
-                )?;
-                out.clear();
-                scratch.loads_into(0, out);
-                Ok(())
-            }
-            RecordEvent::Finish(k, loads) => {
-                if let Some(l) = loads {
-                    rec.set_loads(k, l);
-                }
-                match sink.as_mut() {
-                    Some(sink) => sink(&rec.row(k)),
-                    None => Ok(()),
-                }
-            }
-        }
-    });
-    if let Err(error) = result {
-        return Ok(Err(Box::new(TrainFailure { error, record: finish(Some(&hht), rec) })));
-    }
-    Ok(Ok(finish(Some(&hht), rec)))
+    let rec = TrainRecord { static_wheel_load: cars[0].static_wheel_load, dof: mb.dof(), ..Default::default() };
+    let init = mb.initial_coordinates();
+    let hints = cars.iter().flat_map(|c| [c.station; 4]).collect();
+    let run = RigidRun { sc, cars, couplers, hints };
+    Ok(drive(run, mb, init, sc, observe, sink, rec).map_err(|(error, record)| Box::new(TrainFailure { error, record })))
 }
 
 #[cfg(test)]
