@@ -28,6 +28,7 @@ use ancf_core::contact::{PointJacobian, TankKinematics, WallContact};
 use ancf_core::error::AncfError;
 use ancf_core::shape::N_SHAPE;
 use nalgebra::{Matrix3, Vector3};
+use rayon::prelude::*;
 
 use crate::fluid_blocks::FluidBlocks;
 use crate::integrator::{KktIndex, LinearSolverKind, MechanicalSystem, SparsityPattern, SystemError};
@@ -236,13 +237,46 @@ impl FluidVehicle {
             None,
         )
     }
+}
 
-    /// Contact forces on fluid `k` (into `out`, its slice) and the generalized load on its tank.
-    fn contact_pass(&self, k: usize, tank: &BodyState, e: &[f64], ed: &[f64], out: &mut [f64]) -> [f64; 7] {
-        let f = &self.fluids[k];
-        let load = f.contact.forces(&f.body, &tank_kinematics(tank), e, ed, out, None);
-        tank.generalized(&Vector3::from(load.force), &Vector3::from(load.moment))
+/// Fluid `f`'s generalized forces (internal, gravity `g`, wall contact) into `of`, its slice of
+/// the system's forces (coordinates from `offset` in `q`, `v`), and its load on the tank body.
+#[allow(clippy::too_many_arguments)]
+fn fluid_forces(
+    f: &TankFluid,
+    offset: usize,
+    ws: &mut ForceWorkspace,
+    tank: &BodyState,
+    q: &[f64],
+    v: &[f64],
+    g: Vector3<f64>,
+    of: &mut [f64],
+) -> Result<[f64; 7], SystemError> {
+    let n = f.body.n_coords();
+    let (e, ed) = (&q[offset..offset + n], &v[offset..offset + n]);
+    f.body.internal_forces_with(ws, e, ed, of)?;
+    of.iter_mut().for_each(|x| *x = -*x);
+    for (s, o) in f.body.gravity_scale().iter().zip(of.chunks_exact_mut(3)) {
+        for i in 0..3 {
+            o[i] += s * g[i];
+        }
     }
+    Ok(contact_load(f, tank, e, ed, of))
+}
+
+/// Adds a fluid's generalized load to its tank body's 7 rows of the rigid forces.
+fn add_tank_load(rigid: &mut [f64], f: &TankFluid, load_gen: &[f64; 7]) {
+    let o = 7 * f.tank.0;
+    for i in 0..7 {
+        rigid[o + i] += load_gen[i];
+    }
+}
+
+/// Adds the wall-contact forces of fluid `f` in `tank` to `out` and returns its load on the tank
+/// body as generalized forces on the body's 7 coordinates.
+fn contact_load(f: &TankFluid, tank: &BodyState, e: &[f64], ed: &[f64], out: &mut [f64]) -> [f64; 7] {
+    let load = f.contact.forces(&f.body, &tank_kinematics(tank), e, ed, out, None);
+    tank.generalized(&Vector3::from(load.force), &Vector3::from(load.moment))
 }
 
 impl MechanicalSystem for FluidVehicle {
@@ -303,29 +337,47 @@ impl MechanicalSystem for FluidVehicle {
         Ok(())
     }
 
+    /// The rigid forces, then each fluid's internal, gravity and wall-contact forces and its
+    /// load on the tank body. With several fluids and threads the fluids are evaluated in
+    /// parallel (their coordinates are disjoint and follow the rigid ones in order); either
+    /// way their loads are added to the tank rows in fluid order, so the result does not
+    /// depend on the thread count. The sequential path does not allocate.
     fn forces(&mut self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) -> Result<(), SystemError> {
         let nr = self.n_rigid;
         out.fill(0.0);
         MechanicalSystem::forces(&mut self.mb, t, &q[..nr], &v[..nr], &mut out[..nr])?;
         let g = self.mb.gravity;
-        for k in 0..self.fluids.len() {
-            let lay = &self.layouts[k];
-            let f = &self.fluids[k];
-            let n = f.body.n_coords();
-            let (e, ed) = (&q[lay.offset..lay.offset + n], &v[lay.offset..lay.offset + n]);
-            let of = &mut out[lay.offset..lay.offset + n];
-            f.body.internal_forces_with(&mut self.workspaces[k], e, ed, of).map_err(SystemError::from)?;
-            of.iter_mut().for_each(|x| *x = -*x);
-            for (s, o) in f.body.gravity_scale().iter().zip(of.chunks_exact_mut(3)) {
-                for i in 0..3 {
-                    o[i] += s * g[i];
-                }
+        let (rigid, fluid_out) = out.split_at_mut(nr);
+        if self.fluids.len() > 1 && rayon::current_num_threads() > 1 {
+            let tanks: Vec<BodyState> =
+                self.fluids.iter().map(|f| self.mb.state(Some(f.tank), &q[..nr], &v[..nr])).collect();
+            let mut slices = Vec::with_capacity(self.fluids.len());
+            let mut rest = fluid_out;
+            for f in &self.fluids {
+                let (of, tail) = rest.split_at_mut(f.body.n_coords());
+                slices.push(of);
+                rest = tail;
             }
-            let tank = self.mb.state(Some(f.tank), &q[..nr], &v[..nr]);
-            let load_gen = self.contact_pass(k, &tank, e, ed, of);
-            let o = 7 * f.tank.0;
-            for i in 0..7 {
-                out[o + i] += load_gen[i];
+            let mut workspaces = std::mem::take(&mut self.workspaces);
+            let (fluids, layouts) = (&self.fluids, &self.layouts);
+            let loads: Vec<Result<[f64; 7], SystemError>> = slices
+                .into_par_iter()
+                .zip(workspaces.par_iter_mut())
+                .enumerate()
+                .map(|(k, (of, ws))| fluid_forces(&fluids[k], layouts[k].offset, ws, &tanks[k], q, v, g, of))
+                .collect();
+            self.workspaces = workspaces;
+            for (f, load_gen) in self.fluids.iter().zip(loads) {
+                add_tank_load(rigid, f, &load_gen?);
+            }
+        } else {
+            for k in 0..self.fluids.len() {
+                let (f, offset) = (&self.fluids[k], self.layouts[k].offset);
+                let n = f.body.n_coords();
+                let of = &mut fluid_out[offset - nr..offset - nr + n];
+                let tank = self.mb.state(Some(f.tank), &q[..nr], &v[..nr]);
+                let load_gen = fluid_forces(f, offset, &mut self.workspaces[k], &tank, q, v, g, of)?;
+                add_tank_load(rigid, f, &load_gen);
             }
         }
         if let Some(i) = out.iter().position(|x| !x.is_finite()) {
@@ -456,7 +508,7 @@ impl MechanicalSystem for FluidVehicle {
             // Tank columns: forward differences of the contact pass.
             let t0 = 7 * f.tank.0;
             base.fill(0.0);
-            let gen0 = self.contact_pass(k, &tank, e, ed, &mut base);
+            let gen0 = contact_load(&self.fluids[k], &tank, e, ed, &mut base);
             let mut qt = [0.0; 7];
             let mut vt = [0.0; 7];
             qt.copy_from_slice(&q[t0..t0 + 7]);
@@ -474,7 +526,7 @@ impl MechanicalSystem for FluidVehicle {
                 let st = BodyState::from_coordinates(&qp, &vp);
                 fp.clear();
                 fp.resize(n, 0.0);
-                let load_gen = self.contact_pass(k, &st, e, ed, &mut fp);
+                let load_gen = contact_load(&self.fluids[k], &st, e, ed, &mut fp);
                 let (target, col) = if c < 7 { (&mut *dq, c) } else { (&mut *dv, c - 7) };
                 for r in 0..n {
                     let d = (fp[r] - base[r]) / h;
