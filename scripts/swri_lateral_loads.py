@@ -23,7 +23,7 @@ def main() -> None:
     counts = (2, 4, 2) if a.quick else (3, 6, 3)
     mesh = rs.mesh.elliptic_cylinder(n_length=counts[0], n_width=counts[1], n_height=counts[2])
     depth = mesh.free_surface_z + rs.mesh.SWRI_SEMI_AXIS_Z
-    tank = rs.slosh.elliptic_tank(rs.mesh.SWRI_LENGTH, rs.mesh.SWRI_SEMI_AXIS_Y, rs.mesh.SWRI_SEMI_AXIS_Z)
+    tank = rs.slosh.TankGeometry.elliptic(rs.mesh.SWRI_LENGTH, rs.mesh.SWRI_SEMI_AXIS_Y, rs.mesh.SWRI_SEMI_AXIS_Z)
     motion = rs.slosh.Motion().pulse("y", 0.3 * 9.81, 0.0, 0.5)
     # the SwRI scenes' quadrature (examples/scenes/swri_*.toml): with 3^3 force points and 3x3
     # contact points the field of these elements folds between the points (docs/validation.md)

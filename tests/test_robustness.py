@@ -15,7 +15,7 @@ import pytest
 from railslosh import cli, fluids, mesh, rail, robustness, slosh
 
 BOX = (0.416, 0.324, 0.132)
-TANK = slosh.box_tank((-0.208, -0.162, 0.0), (0.208, 0.162, 0.3))
+TANK = slosh.TankGeometry.box((-0.208, -0.162, 0.0), (0.208, 0.162, 0.3))
 
 
 @pytest.fixture(scope="module")
@@ -148,7 +148,7 @@ import hashlib, numpy as np
 from railslosh import fluids, mesh, rail, slosh, vehicle
 h = hashlib.sha256()
 if {kind!r} == "slosh":
-    tank = slosh.box_tank((-0.208, -0.162, 0.0), (0.208, 0.162, 0.3))
+    tank = slosh.TankGeometry.box((-0.208, -0.162, 0.0), (0.208, 0.162, 0.3))
     motion = slosh.Motion().pulse("y", 3.0, 0.0, 0.1)
     res = slosh.run(mesh.box({BOX!r}, (2, 3, 2)), fluids.water(depth=0.132), tank, motion, t_end=0.1, h=0.01)
     keys = ["t", "force_tank", "volume", "com_tank", "newton_iterations"]
@@ -239,7 +239,7 @@ def test_a_killed_run_keeps_every_sample_it_streamed(tmp_path):
     path = tmp_path / "killed.rsl"
     script = f"""
 from railslosh import fluids, mesh, slosh
-tank = slosh.box_tank((-0.208, -0.162, 0.0), (0.208, 0.162, 0.3))
+tank = slosh.TankGeometry.box((-0.208, -0.162, 0.0), (0.208, 0.162, 0.3))
 motion = slosh.Motion().pulse("y", 3.0, 0.0, 0.1)
 slosh.run(mesh.box({BOX!r}, (2, 3, 2)), fluids.water(depth=0.132), tank, motion, t_end=100.0, stream={str(path)!r})
 """

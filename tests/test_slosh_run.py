@@ -8,7 +8,7 @@ import railslosh as rs
 
 def small_tank():
     mesh = rs.mesh.box((0.4, 0.3, 0.12), (2, 2, 1))
-    tank = rs.slosh.box_tank((-0.2, -0.15, 0.0), (0.2, 0.15, 0.3))
+    tank = rs.slosh.TankGeometry.box((-0.2, -0.15, 0.0), (0.2, 0.15, 0.3))
     return mesh, tank, rs.fluids.water(depth=0.12)
 
 
@@ -42,7 +42,7 @@ def test_bad_inputs_name_the_field():
     with pytest.raises(ValueError, match="frame"):
         rs.slosh.run(mesh, water, tank, t_end=0.1, frame="rotating")
     with pytest.raises(ValueError, match="tank"):
-        rs.slosh.run(mesh, water, rs.slosh.Tank("sphere", (1.0,)), t_end=0.1)
+        rs.slosh.run(mesh, water, rs.slosh.TankGeometry("sphere", (1.0,)), t_end=0.1)
     with pytest.raises(ValueError, match="axis"):
         rs.slosh.Motion().pulse("w", 1.0, 0.0, 1.0)
     with pytest.raises(ValueError, match="h"):
@@ -99,7 +99,7 @@ def test_critical_wall_damping_takes_the_wall_ringing_out_of_the_load():
     L = (0.416, 0.324, 0.132)
     m = rs.mesh.box(L, (2, 6, 2), origin=(-L[0] / 2, -L[1] / 2, 0.0))
     water = rs.fluids.water(depth=L[2])
-    tank = rs.slosh.box_tank((-L[0] / 2, -L[1] / 2, 0.0), (L[0] / 2, L[1] / 2, 0.3))
+    tank = rs.slosh.TankGeometry.box((-L[0] / 2, -L[1] / 2, 0.0), (L[0] / 2, L[1] / 2, 0.3))
     motion = rs.slosh.Motion().pulse("y", 0.3 * 9.81, 0.1, 0.6, ramp=0.02)
     kw = dict(t_end=3.0, h=0.004, penalty_points=4, contact_points_per_edge=4)
     share, f1 = {}, {}
@@ -138,3 +138,19 @@ def test_the_explicit_stepper_stays_stable_with_critically_damped_walls():
     fi = np.asarray(imp["force_tank"])[:, 1]
     fe = np.interp(imp["t"], exp["t"], np.asarray(exp["force_tank"])[:, 1])
     assert np.sqrt((fe**2).mean()) == pytest.approx(np.sqrt((fi**2).mean()), rel=0.02)
+
+
+def test_tank_geometry_constructors_and_the_deprecated_names():
+    """``TankGeometry.{cylinder, elliptic, box}`` build the tank; the old ``*_tank`` functions
+    and ``Tank`` still work for one release and warn (``mesh.cylinder_tank`` is the mesh)."""
+    g = rs.slosh.TankGeometry
+    assert g.box((0.0, 0.0, 0.0), (1.0, 2.0, 3.0)) == g("box", (0.0, 0.0, 0.0, 1.0, 2.0, 3.0))
+    assert g.cylinder(10.0, 1.5, 0.5, [(0.0, 0.02)]).bulkheads == ((0.0, 0.02),)
+    assert g.elliptic(0.324, 0.2, 0.13).shape == "elliptic"
+    assert rs.slosh.Tank is g
+    with pytest.warns(DeprecationWarning, match="TankGeometry.box"):
+        assert rs.slosh.box_tank((0.0, 0.0, 0.0), (1.0, 2.0, 3.0)) == g.box((0.0, 0.0, 0.0), (1.0, 2.0, 3.0))
+    with pytest.warns(DeprecationWarning, match="TankGeometry.cylinder"):
+        rs.slosh.cylinder_tank(10.0, 1.5, 0.5)
+    with pytest.warns(DeprecationWarning, match="TankGeometry.elliptic"):
+        rs.slosh.elliptic_tank(0.324, 0.2, 0.13)

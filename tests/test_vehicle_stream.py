@@ -76,7 +76,7 @@ def test_slosh_run_resumed_from_its_checkpoint_continues_bitwise(tmp_path):
     import railslosh as rs
 
     mesh = rs.mesh.box((0.416, 0.324, 0.132), (2, 3, 2), origin=(-0.208, -0.162, 0.0))
-    tank = rs.slosh.box_tank((-0.208, -0.162, 0.0), (0.208, 0.162, 0.3))
+    tank = rs.slosh.TankGeometry.box((-0.208, -0.162, 0.0), (0.208, 0.162, 0.3))
     motion = rs.slosh.Motion().pulse("y", 0.3 * 9.81, 0.0, 0.3)
     water = rs.fluids.water(depth=0.132)
     ck = tmp_path / "run.ckpt"

@@ -91,7 +91,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
     # braking: the car decelerates at 0.1 g (about 40 -> 5 km/h in 10 s) from t = 0.2 s
     run_mesh = rs.mesh.cylinder_tank(fill=args.fill, n_length=args.n_length, n_width=2, n_height=2)
-    tank = rs.slosh.cylinder_tank(rs.mesh.TANK_CAR_LENGTH, rs.mesh.TANK_CAR_RADIUS, rs.mesh.TANK_CAR_HEAD_DEPTH)
+    tank = rs.slosh.TankGeometry.cylinder(rs.mesh.TANK_CAR_LENGTH, rs.mesh.TANK_CAR_RADIUS, rs.mesh.TANK_CAR_HEAD_DEPTH)
     motion = rs.slosh.Motion().pulse("x", -0.1 * GRAVITY, 0.2, 100.0, ramp=0.2)
     print(
         f"  braking run: -0.1 g from t = 0.2 s for {args.t_end} s, {run_mesh.n_elements} bricks "

@@ -248,7 +248,7 @@ def _run_slosh(kw: dict[str, Any]) -> tuple[dict[str, Any], float]:
     depth = kw["fill"] * _TANK_HEIGHT
     fluid = _fluid(kw, depth)
     m = mesh.box((lx, ly, depth), kw["counts"])
-    tank = slosh.box_tank((-lx / 2, -ly / 2, 0.0), (lx / 2, ly / 2, _TANK_HEIGHT))
+    tank = slosh.TankGeometry.box((-lx / 2, -ly / 2, 0.0), (lx / 2, ly / 2, _TANK_HEIGHT))
     motion = slosh.Motion()
     for axis, a in zip("xyz", kw["accel"], strict=True):
         if a != 0.0:

@@ -901,7 +901,7 @@ class SloshScene:
     """
 
     tank: Any
-    """The :class:`railslosh.slosh.Tank`."""
+    """The :class:`railslosh.slosh.TankGeometry`."""
     fluid: FluidSpec
     maneuver: Mapping[str, Any]
     """The validated ``[maneuver]`` table, SI units."""
@@ -1155,7 +1155,7 @@ def _slosh_tank(tk: Mapping[str, Any], counts: tuple[int, int, int]) -> Any:
         if k != "shape" and k not in allowed:
             raise _fail(f"tank.{k}", tk[k], f"not with shape = {shape!r} (allowed: {', '.join(allowed)})")
     if shape == "elliptic":
-        return slosh.elliptic_tank(
+        return slosh.TankGeometry.elliptic(
             _number(tk.get("length", mesh.SWRI_LENGTH), "tank.length", 0.05, 50.0, "m"),
             _number(tk.get("semi_axis_y", mesh.SWRI_SEMI_AXIS_Y), "tank.semi_axis_y", 0.02, 5.0, "m"),
             _number(tk.get("semi_axis_z", mesh.SWRI_SEMI_AXIS_Z), "tank.semi_axis_z", 0.02, 5.0, "m"),
@@ -1165,13 +1165,13 @@ def _slosh_tank(tk: Mapping[str, Any], counts: tuple[int, int, int]) -> Any:
         radius = _number(tk.get("radius", mesh.TANK_CAR_RADIUS), "tank.radius", 0.05, 5.0, "m")
         head = _number(tk.get("head_depth", mesh.TANK_CAR_HEAD_DEPTH), "tank.head_depth", 0.0, radius, "m (<= radius)")
         bh = _bulkheads(tk.get("bulkheads", []), "tank.bulkheads", length / 2, counts[0])
-        return slosh.cylinder_tank(length, radius, head, bh)
+        return slosh.TankGeometry.cylinder(length, radius, head, bh)
     lo = [_number(x, f"tank.lower[{i}]", -50.0, 50.0, "m") for i, x in enumerate(_list3(tk.get("lower"), "tank.lower"))]
     hi = [_number(x, f"tank.upper[{i}]", -50.0, 50.0, "m") for i, x in enumerate(_list3(tk.get("upper"), "tank.upper"))]
     for i in range(3):
         if hi[i] <= lo[i] + 0.01:
             raise _fail(f"tank.upper[{i}]", hi[i], f"> tank.lower[{i}] + 0.01 = {lo[i] + 0.01:g} m")
-    return slosh.box_tank((lo[0], lo[1], lo[2]), (hi[0], hi[1], hi[2]))
+    return slosh.TankGeometry.box((lo[0], lo[1], lo[2]), (hi[0], hi[1], hi[2]))
 
 
 def _list3(v: Any, fieldname: str) -> list[Any]:

@@ -2,7 +2,7 @@
 
     >>> import railslosh as rs
     >>> mesh = rs.mesh.box((0.416, 0.324, 0.132), (3, 6, 2))
-    >>> tank = rs.slosh.box_tank((-0.208, -0.162, 0.0), (0.208, 0.162, 0.3))
+    >>> tank = rs.slosh.TankGeometry.box((-0.208, -0.162, 0.0), (0.208, 0.162, 0.3))
     >>> motion = rs.slosh.Motion().pulse("y", 0.3 * rs.constants.GRAVITY, 0.0, 0.5)
     >>> res = rs.slosh.run(mesh, rs.fluids.water(depth=0.132), tank, motion, t_end=2.0, h=0.004)
     >>> res["force_tank"].shape  # (steps + 1, 3): load of the fluid on the tank, tank axes
@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import os
 import re
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -26,27 +27,56 @@ AXES = {"x": 0, "y": 1, "z": 2}
 
 
 @dataclass(frozen=True)
-class Tank:
-    """Rigid tank geometry in the tank frame, with optional bulkheads (x, thickness)."""
+class TankGeometry:
+    """Rigid tank geometry in the tank frame, with optional bulkheads (x, thickness): the
+    Python form of ``ancf_core::tank::TankGeometry``. Build it with :meth:`cylinder`,
+    :meth:`elliptic` or :meth:`box`."""
 
     shape: str
     dims: tuple[float, ...]
     bulkheads: tuple[tuple[float, float], ...] = ()
 
+    @classmethod
+    def cylinder(cls, length: float, radius: float, head_depth: float, bulkheads=()) -> TankGeometry:
+        """Horizontal cylinder (axis x, centred) with half-ellipsoidal heads of depth `head_depth`."""
+        return cls("cylinder", (length, radius, head_depth), tuple(bulkheads))
 
-def cylinder_tank(length: float, radius: float, head_depth: float, bulkheads=()) -> Tank:
-    """Horizontal cylinder (axis x, centred) with half-ellipsoidal heads of depth `head_depth`."""
-    return Tank("cylinder", (length, radius, head_depth), tuple(bulkheads))
+    @classmethod
+    def elliptic(cls, length: float, semi_axis_y: float, semi_axis_z: float) -> TankGeometry:
+        """Flat-ended cylinder of elliptical section (the SwRI tank of seed 003)."""
+        return cls("elliptic", (length, semi_axis_y, semi_axis_z))
+
+    @classmethod
+    def box(cls, lower: tuple[float, float, float], upper: tuple[float, float, float]) -> TankGeometry:
+        """Closed rectangular box between two corners."""
+        return cls("box", (*lower, *upper))
 
 
-def elliptic_tank(length: float, semi_axis_y: float, semi_axis_z: float) -> Tank:
-    """Flat-ended cylinder of elliptical section (the SwRI tank of seed 003)."""
-    return Tank("elliptic", (length, semi_axis_y, semi_axis_z))
+Tank = TankGeometry
+"""Deprecated alias of :class:`TankGeometry` (one release)."""
 
 
-def box_tank(lower: tuple[float, float, float], upper: tuple[float, float, float]) -> Tank:
-    """Closed rectangular box between two corners."""
-    return Tank("box", (*lower, *upper))
+def _deprecated(old: str, new: str) -> None:
+    warnings.warn(f"railslosh.slosh.{old} is deprecated: use railslosh.slosh.{new}", DeprecationWarning, stacklevel=3)
+
+
+def cylinder_tank(length: float, radius: float, head_depth: float, bulkheads=()) -> TankGeometry:
+    """Deprecated (one release): :meth:`TankGeometry.cylinder` (``railslosh.mesh.cylinder_tank``
+    is the liquid's mesh, a different thing)."""
+    _deprecated("cylinder_tank", "TankGeometry.cylinder")
+    return TankGeometry.cylinder(length, radius, head_depth, bulkheads)
+
+
+def elliptic_tank(length: float, semi_axis_y: float, semi_axis_z: float) -> TankGeometry:
+    """Deprecated (one release): :meth:`TankGeometry.elliptic`."""
+    _deprecated("elliptic_tank", "TankGeometry.elliptic")
+    return TankGeometry.elliptic(length, semi_axis_y, semi_axis_z)
+
+
+def box_tank(lower: tuple[float, float, float], upper: tuple[float, float, float]) -> TankGeometry:
+    """Deprecated (one release): :meth:`TankGeometry.box`."""
+    _deprecated("box_tank", "TankGeometry.box")
+    return TankGeometry.box(lower, upper)
 
 
 @dataclass
@@ -105,7 +135,7 @@ class SimulationError(RailsloshError):
 def run(
     mesh: FluidMesh,
     fluid: Fluid,
-    tank: Tank,
+    tank: TankGeometry,
     motion: Motion | None = None,
     *,
     t_end: float,
