@@ -157,6 +157,93 @@ pub struct StableStep {
     pub critical: f64,
 }
 
+/// Everything that determines an explicit run's following steps: the state `(t, q, v, a)`,
+/// the stable-step estimator's state (last estimate, steps since it, the power iterations'
+/// warm-start vectors) and the statistics. [`Explicit::restore`] continues from it bit for
+/// bit. The byte format ([`Self::to_bytes`]) is that of the HHT checkpoint with the magic
+/// `RSLEXPCK`: little-endian, `f64` exact, lengths and counters as u64.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExplicitCheckpoint {
+    /// Time, s.
+    pub t: f64,
+    /// Positions.
+    pub q: Vec<f64>,
+    /// Velocities.
+    pub v: Vec<f64>,
+    /// Accelerations.
+    pub a: Vec<f64>,
+    /// Warm start of the stiffness power iteration.
+    pub eigenvector: Vec<f64>,
+    /// Warm start of the damping power iteration.
+    pub damped_vector: Vec<f64>,
+    /// The last stable-step estimate.
+    pub stable: Option<StableStep>,
+    /// Steps since that estimate.
+    pub since_estimate: usize,
+    /// Statistics at the checkpoint.
+    pub stats: Stats,
+}
+
+const EXPLICIT_MAGIC: &[u8; 8] = b"RSLEXPCK";
+const EXPLICIT_VERSION: u32 = 1;
+
+impl ExplicitCheckpoint {
+    /// Serializes to bytes (format in the type docs).
+    pub fn to_bytes(&self) -> Vec<u8> {
+        use super::hht::checkpoint::Writer;
+        let mut w = Writer(Vec::with_capacity(128 + 8 * 5 * self.q.len()));
+        w.0.extend_from_slice(EXPLICIT_MAGIC);
+        w.0.extend_from_slice(&EXPLICIT_VERSION.to_le_bytes());
+        w.f64(self.t);
+        for x in [&self.q, &self.v, &self.a, &self.eigenvector, &self.damped_vector] {
+            w.vec(x);
+        }
+        w.0.push(u8::from(self.stable.is_some()));
+        let s =
+            self.stable.unwrap_or(StableStep { omega_max: 0.0, damping_ratio: 0.0, damping_max: 0.0, critical: 0.0 });
+        for x in [s.omega_max, s.damping_ratio, s.damping_max, s.critical] {
+            w.f64(x);
+        }
+        w.u64(self.since_estimate as u64);
+        w.stats(&self.stats);
+        w.0
+    }
+
+    /// Decodes [`Self::to_bytes`] output; corruption is an [`IntegratorError::Checkpoint`]
+    /// naming the field.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self, IntegratorError> {
+        use super::hht::checkpoint::{Reader, bad};
+        let mut r = Reader { bytes, pos: 0 };
+        if r.take(8, "magic")? != EXPLICIT_MAGIC {
+            return Err(bad("not a railslosh explicit checkpoint (bad magic)"));
+        }
+        let version = u32::from_le_bytes(r.take(4, "version")?.try_into().expect("4 bytes"));
+        if version != EXPLICIT_VERSION {
+            return Err(bad(format!("format version {version}, this build reads {EXPLICIT_VERSION}")));
+        }
+        let t = r.f64("t")?;
+        let (q, v, a) = (r.vec("q")?, r.vec("v")?, r.vec("a")?);
+        let (eigenvector, damped_vector) = (r.vec("eigenvector")?, r.vec("damped_vector")?);
+        let has_stable = r.flag("stable")?;
+        let s = StableStep {
+            omega_max: r.f64("stable.omega_max")?,
+            damping_ratio: r.f64("stable.damping_ratio")?,
+            damping_max: r.f64("stable.damping_max")?,
+            critical: r.f64("stable.critical")?,
+        };
+        let since_estimate = r.usize("since_estimate")?;
+        let stats = r.stats()?;
+        if r.pos != bytes.len() {
+            return Err(bad(format!("{} trailing bytes", bytes.len() - r.pos)));
+        }
+        let n = q.len();
+        if [v.len(), a.len(), eigenvector.len(), damped_vector.len()].iter().any(|&l| l != n) {
+            return Err(bad(format!("q, v, a and the warm-start vectors differ in length (q has {n})")));
+        }
+        Ok(Self { t, q, v, a, eigenvector, damped_vector, stable: has_stable.then_some(s), since_estimate, stats })
+    }
+}
+
 /// The operator of a power iteration (M⁻¹K or M⁻¹C).
 #[derive(Debug, Clone, Copy)]
 enum Operator {
@@ -249,6 +336,61 @@ impl<S: MechanicalSystem> Explicit<S> {
             stable: None,
             since_estimate: 0,
             stats,
+        })
+    }
+
+    /// Snapshot of everything that determines the following steps ([`ExplicitCheckpoint`]).
+    /// Taking it does not change the run.
+    pub fn checkpoint(&self) -> ExplicitCheckpoint {
+        ExplicitCheckpoint {
+            t: self.t,
+            q: self.q.clone(),
+            v: self.v.clone(),
+            a: self.a.clone(),
+            eigenvector: self.eigenvector.clone(),
+            damped_vector: self.damped_vector.clone(),
+            stable: self.stable,
+            since_estimate: self.since_estimate,
+            stats: self.stats,
+        }
+    }
+
+    /// Continues a run from `checkpoint` with the same `system` (rebuilt by the caller: same
+    /// mesh, fluid, tank, motion) and its mass block `m_s`; the steps that follow are bit for
+    /// bit those of the uninterrupted run.
+    pub fn restore(
+        system: S,
+        m_s: &SparseColMat<usize, f64>,
+        checkpoint: &ExplicitCheckpoint,
+        params: ExplicitParams,
+    ) -> Result<Self, IntegratorError> {
+        params.validate()?;
+        let n = system.n_coords();
+        if system.n_constraints() != 0 || 3 * m_s.nrows() != n || checkpoint.q.len() != n {
+            return Err(IntegratorError::Checkpoint {
+                what: format!(
+                    "the checkpoint has {} coordinates; the system has {n} (3 × dim M_s = {}, constraints {})",
+                    checkpoint.q.len(),
+                    3 * m_s.nrows(),
+                    system.n_constraints()
+                ),
+            });
+        }
+        let c = checkpoint.clone();
+        Ok(Self {
+            system,
+            mass: BlockMass::new(m_s)?,
+            params,
+            t: c.t,
+            q: c.q,
+            v: c.v,
+            a: c.a,
+            force: vec![0.0; n],
+            eigenvector: c.eigenvector,
+            damped_vector: c.damped_vector,
+            stable: c.stable,
+            since_estimate: c.since_estimate,
+            stats: c.stats,
         })
     }
 

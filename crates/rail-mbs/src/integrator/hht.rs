@@ -8,7 +8,7 @@ use super::params::{HhtParams, JacobianPolicy, Predictor, StepControl};
 use super::stats::Stats;
 use super::system::{MechanicalSystem, SparsityPattern};
 
-mod checkpoint;
+pub(crate) mod checkpoint;
 pub use checkpoint::Checkpoint;
 
 /// How the Newton matrix is refreshed during one step attempt.

@@ -140,7 +140,7 @@ mod stats;
 mod system;
 
 pub use error::{FailureCause, IntegratorError, KktIndex, Quantity, SystemError};
-pub use explicit::{BlockMass, Explicit, ExplicitParams, StableStep};
+pub use explicit::{BlockMass, Explicit, ExplicitCheckpoint, ExplicitParams, StableStep};
 pub use hht::{Checkpoint, Hht, StateRef, StepInfo};
 pub use iterative::{IterativeParams, LinearSolverKind};
 pub use journal::{CheckpointFile, Journal, read_journal};

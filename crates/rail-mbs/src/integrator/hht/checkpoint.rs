@@ -63,37 +63,54 @@ pub struct Checkpoint {
     pub stats: Stats,
 }
 
-struct Writer(Vec<u8>);
+pub(crate) struct Writer(pub(crate) Vec<u8>);
 
 impl Writer {
-    fn u64(&mut self, x: u64) {
+    pub(crate) fn u64(&mut self, x: u64) {
         self.0.extend_from_slice(&x.to_le_bytes());
     }
-    fn f64(&mut self, x: f64) {
+    pub(crate) fn f64(&mut self, x: f64) {
         self.0.extend_from_slice(&x.to_le_bytes());
     }
-    fn vec(&mut self, x: &[f64]) {
+    pub(crate) fn vec(&mut self, x: &[f64]) {
         self.u64(x.len() as u64);
         for &v in x {
             self.f64(v);
         }
     }
-    fn dur(&mut self, d: Duration) {
+    pub(crate) fn dur(&mut self, d: Duration) {
         self.u64(u64::try_from(d.as_nanos()).unwrap_or(u64::MAX));
+    }
+    /// The counters, then the durations, in [`Stats`] declaration order.
+    pub(crate) fn stats(&mut self, s: &Stats) {
+        for c in [
+            s.steps,
+            s.rejected_steps,
+            s.newton_iterations,
+            s.factorizations,
+            s.jacobian_evaluations,
+            s.residual_evaluations,
+            s.linear_solves,
+        ] {
+            self.u64(c as u64);
+        }
+        for d in [s.time_assembly, s.time_factorization, s.time_solve, s.time_total] {
+            self.dur(d);
+        }
     }
 }
 
-struct Reader<'a> {
-    bytes: &'a [u8],
-    pos: usize,
+pub(crate) struct Reader<'a> {
+    pub(crate) bytes: &'a [u8],
+    pub(crate) pos: usize,
 }
 
-fn bad(what: impl Into<String>) -> IntegratorError {
+pub(crate) fn bad(what: impl Into<String>) -> IntegratorError {
     IntegratorError::Checkpoint { what: what.into() }
 }
 
 impl Reader<'_> {
-    fn take(&mut self, k: usize, field: &str) -> Result<&[u8], IntegratorError> {
+    pub(crate) fn take(&mut self, k: usize, field: &str) -> Result<&[u8], IntegratorError> {
         let end = self.pos.checked_add(k).filter(|&e| e <= self.bytes.len());
         let Some(end) = end else {
             return Err(bad(format!("truncated at byte {} while reading `{field}`", self.pos)));
@@ -102,33 +119,49 @@ impl Reader<'_> {
         self.pos = end;
         Ok(s)
     }
-    fn u64(&mut self, field: &str) -> Result<u64, IntegratorError> {
+    pub(crate) fn u64(&mut self, field: &str) -> Result<u64, IntegratorError> {
         let b = self.take(8, field)?;
         Ok(u64::from_le_bytes(b.try_into().expect("8 bytes")))
     }
-    fn usize(&mut self, field: &str) -> Result<usize, IntegratorError> {
+    pub(crate) fn usize(&mut self, field: &str) -> Result<usize, IntegratorError> {
         let x = self.u64(field)?;
         usize::try_from(x).map_err(|_| bad(format!("`{field}` = {x} does not fit usize")))
     }
-    fn f64(&mut self, field: &str) -> Result<f64, IntegratorError> {
+    pub(crate) fn f64(&mut self, field: &str) -> Result<f64, IntegratorError> {
         Ok(f64::from_bits(self.u64(field)?))
     }
-    fn flag(&mut self, field: &str) -> Result<bool, IntegratorError> {
+    pub(crate) fn flag(&mut self, field: &str) -> Result<bool, IntegratorError> {
         match self.take(1, field)?[0] {
             0 => Ok(false),
             1 => Ok(true),
             x => Err(bad(format!("`{field}` flag is {x}, expected 0 or 1"))),
         }
     }
-    fn vec(&mut self, field: &str) -> Result<Vec<f64>, IntegratorError> {
+    pub(crate) fn vec(&mut self, field: &str) -> Result<Vec<f64>, IntegratorError> {
         let len = self.usize(field)?;
         if len > (self.bytes.len() - self.pos) / 8 {
             return Err(bad(format!("`{field}` claims {len} values, more than the remaining bytes")));
         }
         (0..len).map(|_| self.f64(field)).collect()
     }
-    fn dur(&mut self, field: &str) -> Result<Duration, IntegratorError> {
+    pub(crate) fn dur(&mut self, field: &str) -> Result<Duration, IntegratorError> {
         Ok(Duration::from_nanos(self.u64(field)?))
+    }
+    /// [`Writer::stats`] read back.
+    pub(crate) fn stats(&mut self) -> Result<Stats, IntegratorError> {
+        Ok(Stats {
+            steps: self.usize("stats.steps")?,
+            rejected_steps: self.usize("stats.rejected_steps")?,
+            newton_iterations: self.usize("stats.newton_iterations")?,
+            factorizations: self.usize("stats.factorizations")?,
+            jacobian_evaluations: self.usize("stats.jacobian_evaluations")?,
+            residual_evaluations: self.usize("stats.residual_evaluations")?,
+            linear_solves: self.usize("stats.linear_solves")?,
+            time_assembly: self.dur("stats.time_assembly")?,
+            time_factorization: self.dur("stats.time_factorization")?,
+            time_solve: self.dur("stats.time_solve")?,
+            time_total: self.dur("stats.time_total")?,
+        })
     }
 }
 
@@ -153,21 +186,7 @@ impl Checkpoint {
         for x in [&self.mass_jac, &self.dq, &self.dv, &self.cq] {
             w.vec(x);
         }
-        let s = &self.stats;
-        for c in [
-            s.steps,
-            s.rejected_steps,
-            s.newton_iterations,
-            s.factorizations,
-            s.jacobian_evaluations,
-            s.residual_evaluations,
-            s.linear_solves,
-        ] {
-            w.u64(c as u64);
-        }
-        for d in [s.time_assembly, s.time_factorization, s.time_solve, s.time_total] {
-            w.dur(d);
-        }
+        w.stats(&self.stats);
         w.0
     }
 
@@ -203,19 +222,7 @@ impl Checkpoint {
         let dq = r.vec("dq")?;
         let dv = r.vec("dv")?;
         let cq = r.vec("cq")?;
-        let stats = Stats {
-            steps: r.usize("stats.steps")?,
-            rejected_steps: r.usize("stats.rejected_steps")?,
-            newton_iterations: r.usize("stats.newton_iterations")?,
-            factorizations: r.usize("stats.factorizations")?,
-            jacobian_evaluations: r.usize("stats.jacobian_evaluations")?,
-            residual_evaluations: r.usize("stats.residual_evaluations")?,
-            linear_solves: r.usize("stats.linear_solves")?,
-            time_assembly: r.dur("stats.time_assembly")?,
-            time_factorization: r.dur("stats.time_factorization")?,
-            time_solve: r.dur("stats.time_solve")?,
-            time_total: r.dur("stats.time_total")?,
-        };
+        let stats = r.stats()?;
         if r.pos != bytes.len() {
             return Err(bad(format!("{} trailing bytes", bytes.len() - r.pos)));
         }
