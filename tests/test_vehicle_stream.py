@@ -95,6 +95,28 @@ def test_slosh_run_resumed_from_its_checkpoint_continues_bitwise(tmp_path):
         rs.slosh.run(mesh, water, tank, motion, t_end=0.6, h=0.004, checkpoint=ck, checkpoint_every=0)
 
 
+def test_explicit_slosh_run_resumed_from_its_checkpoint_continues_bitwise(tmp_path):
+    """Issue 17: explicit runs write checkpoints too (counted in explicit steps), and a run
+    resumed from one continues bit for bit; asking for the other stepper is refused."""
+    import railslosh as rs
+
+    mesh = rs.mesh.box((0.416, 0.324, 0.132), (2, 3, 2), origin=(-0.208, -0.162, 0.0))
+    tank = rs.slosh.TankGeometry.box((-0.208, -0.162, 0.0), (0.208, 0.162, 0.3))
+    motion = rs.slosh.Motion().pulse("y", 0.3 * rs.constants.GRAVITY, 0.0, 0.3)
+    water = rs.fluids.water(depth=0.132)
+    ck = tmp_path / "explicit.ckpt"
+    kw = dict(t_end=0.12, h=0.004, stepper="explicit")
+    full = rs.slosh.run(mesh, water, tank, motion, **kw, checkpoint=ck, checkpoint_every=400)
+    assert ck.read_bytes()[:8] == b"RSLEXPCK"
+    rest = rs.slosh.run(mesh, water, tank, motion, **kw, resume_from=ck)
+    k = int(np.flatnonzero(full["t"] == rest["t"][0])[0])
+    assert 0 < k < len(full["t"]) - 1
+    for key in ("t", "force_tank", "moment_tank", "com_tank", "volume", "kinetic_energy"):
+        assert np.array_equal(rest[key], full[key][k:]), key
+    with pytest.raises(ValueError, match="stepper"):
+        rs.slosh.run(mesh, water, tank, motion, t_end=0.12, h=0.004, stepper="implicit", resume_from=ck)
+
+
 def test_fluid_vehicle_runs_record_their_invariants_per_car_and_sample(tmp_path):
     """Issue 16 §1 for vehicle runs: every sample carries each car's containment gap, smallest
     volume ratio and energy growth (the last accepted step; at t = 0 the initial state, growth 0),

@@ -507,13 +507,6 @@ fn run_slosh<'py>(
     use ancf_core::tank::{Bulkhead, TankGeometry, TankShape};
     use rail_mbs::slosh::{PiecewiseAcceleration, PrescribedMotion, SloshFrame, SloshRun, SloshSystem, StepperChoice};
     let choice = StepperChoice::parse(stepper).map_err(crate::to_py)?;
-    if choice != StepperChoice::Implicit && (resume_from.is_some() || checkpoint.is_some()) {
-        return Err(crate::to_py(ancf_core::error::invalid(
-            "stepper",
-            stepper,
-            "\"implicit\" with checkpoint or resume_from (explicit runs write no checkpoints yet)",
-        )));
-    }
     let bad =
         |f: &str, v: String, a: &str| PyValueError::new_err(format!("invalid parameter `{f}` = {v}: allowed {a}"));
     let shape = match (tank_shape, tank_dims.as_slice()) {
@@ -597,16 +590,26 @@ fn run_slosh<'py>(
         let mut run = match &resume_from {
             // Issue 8: continue a run from its last checkpoint, bitwise as if never stopped.
             Some(path) => {
-                let cp = rail_mbs::integrator::CheckpointFile::read(path).map_err(|e| {
+                let bytes = rail_mbs::integrator::CheckpointFile::read_bytes(path).map_err(|e| {
                     ancf_core::error::invalid("resume_from", path.display(), &format!("a checkpoint file ({e})"))
                 })?;
-                SloshRun::resume(sys, &cp, params).map_err(|e| {
+                let resumed = SloshRun::resume_from_bytes(sys, &bytes, params, explicit).map_err(|e| {
                     ancf_core::error::invalid(
                         "resume_from",
                         path.display(),
                         &format!("a checkpoint of a run of this same scene ({e})"),
                     )
-                })?
+                })?;
+                let used = resumed.stepper.name();
+                if choice != StepperChoice::Auto && used != stepper {
+                    return Err(ancf_core::error::invalid(
+                        "stepper",
+                        stepper,
+                        &format!("\"{used}\" or \"auto\": the checkpoint in resume_from is of an {used} run"),
+                    ));
+                }
+                reason = format!("resumed: {used}");
+                resumed
             }
             None => {
                 let (run, why) = SloshRun::with_choice(sys, 0.0, choice, h, params, explicit)

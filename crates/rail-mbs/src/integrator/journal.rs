@@ -15,7 +15,7 @@ use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-use super::{Checkpoint, Hht, IntegratorError, MechanicalSystem};
+use super::{Checkpoint, Explicit, Hht, IntegratorError, MechanicalSystem};
 
 const MAGIC: &[u8; 8] = b"RSLJRNL1";
 
@@ -153,12 +153,28 @@ impl CheckpointFile {
         Ok(true)
     }
 
+    /// Writes an explicit run's checkpoint if `every` steps have passed since the last one;
+    /// returns whether it wrote.
+    pub fn maybe_write_explicit<S: MechanicalSystem>(&mut self, e: &Explicit<S>) -> Result<bool, IntegratorError> {
+        let steps = e.stats().steps;
+        if steps < self.last_step + self.every {
+            return Ok(false);
+        }
+        self.write_bytes(&e.checkpoint().to_bytes())?;
+        self.last_step = steps;
+        Ok(true)
+    }
+
     /// Writes `checkpoint` now (atomically: temporary file, sync, rename).
     pub fn write(&mut self, checkpoint: &Checkpoint) -> Result<(), IntegratorError> {
+        self.write_bytes(&checkpoint.to_bytes())
+    }
+
+    fn write_bytes(&mut self, bytes: &[u8]) -> Result<(), IntegratorError> {
         let tmp = self.path.with_extension("tmp");
         let result = (|| {
             let mut f = File::create(&tmp)?;
-            f.write_all(&checkpoint.to_bytes())?;
+            f.write_all(bytes)?;
             f.sync_all()?;
             std::fs::rename(&tmp, &self.path)
         })();
@@ -172,10 +188,15 @@ impl CheckpointFile {
         self.written
     }
 
-    /// Reads the checkpoint at `path`.
+    /// Reads the (implicit) checkpoint at `path`.
     pub fn read(path: impl AsRef<Path>) -> Result<Checkpoint, IntegratorError> {
+        Checkpoint::from_bytes(&Self::read_bytes(path)?)
+    }
+
+    /// The raw bytes of the checkpoint at `path` (an implicit or an explicit one: their magics
+    /// differ, see [`crate::slosh::SloshRun::resume_from_bytes`]).
+    pub fn read_bytes(path: impl AsRef<Path>) -> Result<Vec<u8>, IntegratorError> {
         let path = path.as_ref();
-        let bytes = std::fs::read(path).map_err(|e| io_err(path, "cannot read checkpoint", e))?;
-        Checkpoint::from_bytes(&bytes)
+        std::fs::read(path).map_err(|e| io_err(path, "cannot read checkpoint", e))
     }
 }

@@ -330,21 +330,36 @@ impl SloshRun {
     /// Resume from a checkpoint of an earlier run of the same system (same mesh, fluid,
     /// tank, motion and parameters): the record starts with the checkpoint's state, and
     /// the continuation is bitwise identical to the uninterrupted run's (its first
-    /// sample reports 0 Newton iterations). Implicit runs only.
+    /// sample reports 0 Newton iterations). Implicit runs; [`Self::resume_from_bytes`] takes
+    /// either kind.
     pub fn resume(system: SloshSystem, checkpoint: &Checkpoint, params: HhtParams) -> Result<Self, IntegratorError> {
         let hht = Hht::restore(system, checkpoint, params)?;
         Self::with_stepper(SloshStepper::Implicit(hht))
+    }
+
+    /// Resume from the bytes of a checkpoint file of either stepper (told apart by their
+    /// magic), continuing bit for bit; `implicit`/`explicit` are the stepper parameters of
+    /// the original run.
+    pub fn resume_from_bytes(
+        system: SloshSystem,
+        bytes: &[u8],
+        implicit: HhtParams,
+        explicit: ExplicitParams,
+    ) -> Result<Self, IntegratorError> {
+        if bytes.starts_with(b"RSLEXPCK") {
+            let cp = crate::integrator::ExplicitCheckpoint::from_bytes(bytes)?;
+            let m_s = system.body.scalar_mass().clone();
+            let e = Explicit::restore(system, &m_s, &cp, explicit)?;
+            return Self::with_stepper(SloshStepper::Explicit(Box::new(e)));
+        }
+        Self::resume(system, &Checkpoint::from_bytes(bytes)?, implicit)
     }
 
     /// Write a checkpoint if one is due.
     fn checkpoint_if_due(&mut self) -> Result<(), IntegratorError> {
         match (self.checkpoints.as_mut(), &self.stepper) {
             (Some(c), SloshStepper::Implicit(hht)) => c.maybe_write(hht).map(|_| ()),
-            (Some(_), SloshStepper::Explicit(_)) => Err(IntegratorError::InvalidParameter {
-                field: "checkpoint_every",
-                value: 0.0,
-                allowed: "checkpoints with the implicit stepper only",
-            }),
+            (Some(c), SloshStepper::Explicit(e)) => c.maybe_write_explicit(e).map(|_| ()),
             (None, _) => Ok(()),
         }
     }
