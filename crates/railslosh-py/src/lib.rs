@@ -586,7 +586,7 @@ fn run_slosh<'py>(
         sys.penetration_limit *= penetration_limit / rail_mbs::slosh::system::PENETRATION_LIMIT_FACTOR;
         let params = rail_mbs::defaults::slosh_params();
         let explicit = rail_mbs::integrator::ExplicitParams::default();
-        let mut reason = String::from("requested: implicit");
+        let reason;
         let mut run = match &resume_from {
             // Issue 8: continue a run from its last checkpoint, bitwise as if never stopped.
             Some(path) => {
