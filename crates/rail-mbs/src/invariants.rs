@@ -310,6 +310,22 @@ impl InvariantMonitor {
         }
     }
 
+    /// [`Self::check`] with the state already measured (see [`Self::assess_energy`]).
+    pub fn check_energy(
+        &mut self,
+        t: f64,
+        measured: (f64, f64),
+        energy: EnergySample,
+    ) -> Result<Measured, SystemError> {
+        match self.assess_energy(t, measured, energy) {
+            Ok(p) => Ok(self.commit(p)),
+            Err((e, gap, j)) => {
+                self.note(t, gap, j);
+                Err(e)
+            }
+        }
+    }
+
     /// Checks every invariant of a state without accounting it (for systems with several
     /// liquids, where a step is accepted only when every liquid passes): the result is
     /// given to [`Self::commit`] once the step is accepted. On a violation, the error with
@@ -324,7 +340,19 @@ impl InvariantMonitor {
         q: &[f64],
         energy: EnergySample,
     ) -> Result<Pending, (SystemError, f64, f64)> {
-        let (gap, j) = check_state(|| self.name.clone(), body, contact, kin, q, &self.limits)?;
+        let measured = check_state(|| self.name.clone(), body, contact, kin, q, &self.limits)?;
+        self.assess_energy(t, measured, energy)
+    }
+
+    /// [`Self::assess`] of a state whose containment gap and smallest volume ratio
+    /// `(gap, j)` were already measured by [`check_state`] with this monitor's limits (the
+    /// slosh system's step check): the energy balance only.
+    pub fn assess_energy(
+        &self,
+        t: f64,
+        (gap, j): (f64, f64),
+        energy: EnergySample,
+    ) -> Result<Pending, (SystemError, f64, f64)> {
         // energy: trapezoidal work over the step since the last accepted state
         let (mut work, mut abs_work) = (self.input_work, self.abs_work);
         if let Some((t_last, p_last)) = self.last {

@@ -69,6 +69,9 @@ pub struct SloshSystem {
     /// Reused buffers: force evaluation and element Jacobians.
     workspace: ForceWorkspace,
     jacobians: Vec<ElementJacobian>,
+    /// What the last passed step check measured (the run's monitor reuses it for the same
+    /// state instead of measuring it again).
+    pub(crate) last_state_check: Option<StateCheck>,
 }
 
 impl SloshSystem {
@@ -114,6 +117,7 @@ impl SloshSystem {
             gravity,
             frame,
             tank_input: None,
+            last_state_check: None,
             linear_solver: LinearSolverKind::Direct,
             pattern,
             layout,
@@ -345,8 +349,9 @@ impl MechanicalSystem for SloshSystem {
         // co-simulation participant and the FMU
         let limits = crate::invariants::InvariantLimits::new(self.penetration_limit);
         let kin = self.contact_kinematics(t);
-        crate::invariants::check_state(|| "fluid".into(), &self.body, &self.contact, &kin, q, &limits)
+        let measured = crate::invariants::check_state(|| "fluid".into(), &self.body, &self.contact, &kin, q, &limits)
             .map_err(|(error, _, _)| error)?;
+        self.last_state_check = Some(StateCheck { t, q_bits: state_bits(q), measured });
         Ok(())
     }
 
@@ -399,4 +404,19 @@ impl MechanicalSystem for SloshSystem {
         self.point_jac = pj;
         Ok(())
     }
+}
+
+/// The state invariants measured by the last passed [`SloshSystem::check_step`]: the time, a
+/// fingerprint of the coordinates and (containment gap, smallest volume ratio).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct StateCheck {
+    pub(crate) t: f64,
+    pub(crate) q_bits: u64,
+    pub(crate) measured: (f64, f64),
+}
+
+/// A fingerprint of the exact bits of `q` (FNV-1a over every value), so that a cached
+/// measurement is used only for the very state it measured.
+pub(crate) fn state_bits(q: &[f64]) -> u64 {
+    q.iter().fold(0xcbf2_9ce4_8422_2325_u64, |h, x| (h ^ x.to_bits()).wrapping_mul(0x0100_0000_01b3))
 }
