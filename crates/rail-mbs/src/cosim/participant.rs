@@ -331,10 +331,7 @@ impl SloshParticipant {
         let kin = sys.contact_kinematics(t);
         let stored = crate::invariants::stored_energy(&sys.body, &sys.contact, &kin, q);
         let energy = sys.tank_frame_energy(t, q, v, stored);
-        monitor
-            .check(t, &sys.body, &sys.contact, &kin, q, energy)
-            .map(|_| ())
-            .map_err(|source| IntegratorError::System { t, source })
+        sys.account_state(monitor, t, q, energy).map(|_| ()).map_err(|source| IntegratorError::System { t, source })
     }
 
     /// A new energy account from the current state (margins kept).

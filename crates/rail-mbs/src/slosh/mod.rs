@@ -505,20 +505,7 @@ impl SloshRun {
             },
             SloshFrame::Tank => sys.tank_frame_energy(t, q, v, stored),
         };
-        // the step check of this very state (same time, same coordinate bits) already measured
-        // containment and element validity; within this monitor's limits only the energy
-        // balance is left to check, otherwise the full check names the violation
-        let limits = self.invariants.limits;
-        let cached = sys.last_state_check.filter(|c| {
-            c.t == t
-                && c.q_bits == system::state_bits(q)
-                && c.measured.0 <= limits.containment
-                && c.measured.1 > limits.min_volume_ratio
-        });
-        let checked = match cached {
-            Some(c) => self.invariants.check_energy(t, c.measured, energy),
-            None => self.invariants.check(t, body, &sys.contact, &kin, q, energy),
-        };
+        let checked = sys.account_state(&mut self.invariants, t, q, energy);
         let m = checked.as_ref().ok();
         let w = self.invariants.input_work();
         r.input_work.push(m.map_or(w, |m| m.input_work));

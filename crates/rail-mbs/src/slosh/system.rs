@@ -75,6 +75,30 @@ pub struct SloshSystem {
 }
 
 impl SloshSystem {
+    /// Accounts the accepted state `(t, q)` in `monitor` (a run's invariant account, energy
+    /// sample `energy`). When the last passed [`MechanicalSystem::check_step`] measured this
+    /// very state (same time and coordinate bits) within the monitor's limits, only the
+    /// energy balance is left to check; otherwise the full check runs and names any violation.
+    pub(crate) fn account_state(
+        &self,
+        monitor: &mut crate::invariants::InvariantMonitor,
+        t: f64,
+        q: &[f64],
+        energy: crate::invariants::EnergySample,
+    ) -> Result<crate::invariants::Measured, SystemError> {
+        let limits = monitor.limits;
+        let cached = self.last_state_check.filter(|c| {
+            c.t == t
+                && c.q_bits == state_bits(q)
+                && c.measured.0 <= limits.containment
+                && c.measured.1 > limits.min_volume_ratio
+        });
+        match cached {
+            Some(c) => monitor.check_energy(t, c.measured, energy),
+            None => monitor.check(t, &self.body, &self.contact, &self.contact_kinematics(t), q, energy),
+        }
+    }
+
     /// The run-time invariant monitor of this system ([`crate::invariants`]): containment
     /// within its penetration limit, default energy and volume-ratio limits.
     pub fn invariant_monitor(&self) -> crate::invariants::InvariantMonitor {
