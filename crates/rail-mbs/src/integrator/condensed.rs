@@ -21,13 +21,11 @@
 
 use std::ops::Range;
 
-use faer::sparse::linalg::LuError;
-use faer::sparse::linalg::lu::{LuRef, NumericLu, SymbolicLu, factorize_symbolic_lu};
+use faer::sparse::linalg::lu::{NumericLu, SymbolicLu, factorize_symbolic_lu};
 use faer::sparse::{Pair, SparseColMat, SymbolicSparseColMat};
-use faer::{Conj, MatMut, Par};
 use rayon::prelude::*;
 
-use super::linear::{LinearFailure, Scratch};
+use super::linear::{LinearFailure, Scratch, lu_solve, numeric_lu};
 
 const NONE: usize = usize::MAX;
 
@@ -64,7 +62,7 @@ impl SubLu {
         start + rows.binary_search(&row).expect("entry in the sub-matrix pattern")
     }
 
-    /// Gathers the values from the full matrix (`extra` is added after: the Schur update).
+    /// Gathers the values from the full matrix (the Schur complement adds its update after).
     fn gather_from(&mut self, full: &[f64]) {
         let vals = self.matrix.val_mut();
         vals.fill(0.0);
@@ -77,38 +75,15 @@ impl SubLu {
         if self.matrix.val().iter().any(|v| !v.is_finite()) {
             return Err(LinearFailure::Numeric(None));
         }
-        let req = self.symbolic.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default());
-        let symbolic = &self.symbolic;
-        let matrix = self.matrix.as_ref();
-        let numeric = &mut self.numeric;
-        let stack = self.scratch.stack(req)?;
-        // faer 0.24 can panic on some zero pivots (faer-rs issue #232), as in the direct backend
-        let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            symbolic.factorize_numeric_lu(numeric, matrix, Par::Seq, stack, Default::default()).map(|_| ())
-        }));
-        ancf_core::clear_upper_simd();
-        if !matches!(result, Ok(Ok(()))) {
-            *numeric = NumericLu::new();
-        }
-        match result {
-            Ok(Ok(())) => Ok(()),
-            Ok(Err(LuError::SymbolicSingular { index })) => {
-                Err(LinearFailure::NoPivot(self.global.get(index).copied().unwrap_or(index)))
-            }
-            Ok(Err(LuError::Generic(e))) => Err(LinearFailure::Generic(format!("{e:?}"))),
-            Err(_) => Err(LinearFailure::Numeric(None)),
-        }
+        numeric_lu(&self.symbolic, &mut self.numeric, self.matrix.as_ref(), &mut self.scratch).map_err(|e| match e {
+            LinearFailure::NoPivot(i) => LinearFailure::NoPivot(self.global.get(i).copied().unwrap_or(i)),
+            other => other,
+        })
     }
 
     /// Solves in place for the `ncols` columns of `x` (column-major, `dim` rows).
     fn solve(&mut self, x: &mut [f64], ncols: usize) -> Result<(), LinearFailure> {
-        let dim = self.global.len();
-        let req = self.symbolic.solve_in_place_scratch::<f64>(ncols, Par::Seq);
-        let stack = self.scratch.stack(req)?;
-        let lu = LuRef::new_unchecked(&self.symbolic, &self.numeric);
-        lu.solve_in_place_with_conj(Conj::No, MatMut::from_column_major_slice_mut(x, dim, ncols), Par::Seq, stack);
-        ancf_core::clear_upper_simd();
-        Ok(())
+        lu_solve(&self.symbolic, &self.numeric, &mut self.scratch, x, self.global.len(), ncols)
     }
 }
 

@@ -253,30 +253,9 @@ impl KktSolver {
                 return Ok(());
             }
         };
-        let par = parallelism();
-        let stack = self.scratch.stack(symbolic.factorize_numeric_lu_scratch::<f64>(par, Default::default()))?;
-        // faer 0.24 can panic on some zero pivots (faer-rs issue #232); turn that into
-        // an error instead of unwinding through the integrator.
-        let matrix = self.matrix.as_ref();
-        let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            symbolic.factorize_numeric_lu(numeric, matrix, par, stack, Default::default()).map(|_| ())
-        }));
-        // faer's dense kernels leave the vector registers dirty (`ancf_core::simd`).
-        ancf_core::clear_upper_simd();
-        if !matches!(result, Ok(Ok(()))) {
-            // Failed or unwound mid-factorization: start the next one from an empty numeric
-            // LU rather than from a partly written one (allocates again, on failures only).
-            **numeric = NumericLu::new();
-        }
-        match result {
-            Ok(Ok(())) => {
-                *factored = true;
-                Ok(())
-            }
-            Ok(Err(LuError::SymbolicSingular { index })) => Err(LinearFailure::NoPivot(index)),
-            Ok(Err(LuError::Generic(e))) => Err(LinearFailure::Generic(format!("{e:?}"))),
-            Err(_) => Err(LinearFailure::Numeric(None)),
-        }
+        numeric_lu(symbolic, numeric, self.matrix.as_ref(), &mut self.scratch)?;
+        *factored = true;
+        Ok(())
     }
 
     /// Solves `A x = b` in place (`rhs` holds `b` on entry, `x` on exit), checks
@@ -336,19 +315,59 @@ impl KktSolver {
     }
 }
 
+/// Numeric sparse LU of `matrix` into `numeric` with the symbolic factorization `symbolic`
+/// (the direct backend and every block of the condensed one). faer 0.24 can panic on some zero
+/// pivots (faer-rs issue #232): that becomes an error instead of unwinding through the
+/// integrator. `NoPivot` carries faer's column index in `matrix`.
+pub(crate) fn numeric_lu(
+    symbolic: &SymbolicLu<usize>,
+    numeric: &mut NumericLu<usize, f64>,
+    matrix: faer::sparse::SparseColMatRef<'_, usize, f64>,
+    scratch: &mut Scratch,
+) -> Result<(), LinearFailure> {
+    let par = parallelism();
+    let stack = scratch.stack(symbolic.factorize_numeric_lu_scratch::<f64>(par, Default::default()))?;
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        symbolic.factorize_numeric_lu(numeric, matrix, par, stack, Default::default()).map(|_| ())
+    }));
+    // faer's dense kernels leave the vector registers dirty (`ancf_core::simd`).
+    ancf_core::clear_upper_simd();
+    if !matches!(result, Ok(Ok(()))) {
+        // Failed or unwound mid-factorization: start the next one from an empty numeric
+        // LU rather than from a partly written one (allocates again, on failures only).
+        *numeric = NumericLu::new();
+    }
+    match result {
+        Ok(Ok(())) => Ok(()),
+        Ok(Err(LuError::SymbolicSingular { index })) => Err(LinearFailure::NoPivot(index)),
+        Ok(Err(LuError::Generic(e))) => Err(LinearFailure::Generic(format!("{e:?}"))),
+        Err(_) => Err(LinearFailure::Numeric(None)),
+    }
+}
+
+/// `x ← A⁻¹ x` for the `ncols` columns of `x` (column-major, `dim` rows) with a numeric LU
+/// from [`numeric_lu`] (the caller knows it succeeded).
+pub(crate) fn lu_solve(
+    symbolic: &SymbolicLu<usize>,
+    numeric: &NumericLu<usize, f64>,
+    scratch: &mut Scratch,
+    x: &mut [f64],
+    dim: usize,
+    ncols: usize,
+) -> Result<(), LinearFailure> {
+    let par = parallelism();
+    let stack = scratch.stack(symbolic.solve_in_place_scratch::<f64>(ncols, par))?;
+    let lu = faer::sparse::linalg::lu::LuRef::new_unchecked(symbolic, numeric);
+    lu.solve_in_place_with_conj(Conj::No, MatMut::from_column_major_slice_mut(x, dim, ncols), par, stack);
+    ancf_core::clear_upper_simd();
+    Ok(())
+}
+
 /// `x ← A⁻¹ x` with the factors of a direct or condensed backend.
 fn apply_inverse(backend: &mut Backend, scratch: &mut Scratch, dim: usize, x: &mut [f64]) -> Result<(), LinearFailure> {
     match backend {
-        Backend::Direct { symbolic, numeric, .. } => {
-            let par = parallelism();
-            let stack = scratch.stack(symbolic.solve_in_place_scratch::<f64>(1, par))?;
-            // `numeric` is the output of `symbolic.factorize_numeric_lu` for this matrix pattern
-            // (the caller checked `factored`, set only after it succeeded).
-            let lu = faer::sparse::linalg::lu::LuRef::new_unchecked(symbolic, numeric);
-            lu.solve_in_place_with_conj(Conj::No, MatMut::from_column_major_slice_mut(x, dim, 1), par, stack);
-            ancf_core::clear_upper_simd();
-            Ok(())
-        }
+        // `factored` was checked by the caller
+        Backend::Direct { symbolic, numeric, .. } => lu_solve(symbolic, numeric, scratch, x, dim, 1),
         Backend::Condensed { cond, .. } => cond.solve(x),
         Backend::Iterative { .. } => Err(LinearFailure::Generic("apply_inverse: iterative backend".into())),
     }
