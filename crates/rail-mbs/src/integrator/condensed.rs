@@ -21,11 +21,10 @@
 
 use std::ops::Range;
 
-use faer::sparse::linalg::lu::{NumericLu, SymbolicLu, factorize_symbolic_lu};
-use faer::sparse::{Pair, SparseColMat, SymbolicSparseColMat};
+use faer::sparse::{Pair, SparseColMat, SparseColMatRef, SymbolicSparseColMat};
 use rayon::prelude::*;
 
-use super::linear::{LinearFailure, Scratch, lu_solve, numeric_lu};
+use super::linear_solver::{LinearFailure, LinearSolver, SparseLu};
 
 const NONE: usize = usize::MAX;
 
@@ -34,9 +33,7 @@ struct SubLu {
     matrix: SparseColMat<usize, f64>,
     /// (value position in `matrix`, value position in the full matrix).
     gather: Vec<(usize, usize)>,
-    symbolic: SymbolicLu<usize>,
-    numeric: NumericLu<usize, f64>,
-    scratch: Scratch,
+    lu: SparseLu,
     /// Full-matrix index of each sub-matrix row and column (for error messages).
     global: Vec<usize>,
 }
@@ -45,13 +42,12 @@ impl SubLu {
     /// `entries`: (row, col) of the sub-matrix (diagonal included by the caller).
     fn new(dim: usize, entries: &[(usize, usize)], global: Vec<usize>) -> Result<Self, LinearFailure> {
         let pairs: Vec<Pair<usize, usize>> = entries.iter().map(|&(row, col)| Pair { row, col }).collect();
-        let (symbolic, _) = SymbolicSparseColMat::try_new_from_indices(dim, dim, &pairs)
-            .map_err(|e| LinearFailure::Generic(format!("{e:?}")))?;
+        let (symbolic, _) =
+            SymbolicSparseColMat::try_new_from_indices(dim, dim, &pairs).map_err(LinearFailure::generic)?;
         let nnz = symbolic.row_idx().len();
         let matrix = SparseColMat::new(symbolic, vec![0.0; nnz]);
-        let symbolic = factorize_symbolic_lu(matrix.symbolic(), Default::default())
-            .map_err(|e| LinearFailure::Generic(format!("{e:?}")))?;
-        Ok(Self { matrix, gather: Vec::new(), symbolic, numeric: NumericLu::new(), scratch: Scratch::new(), global })
+        let lu = SparseLu::new(matrix.symbolic())?;
+        Ok(Self { matrix, gather: Vec::new(), lu, global })
     }
 
     /// Value position of (row, col), which must be in the pattern.
@@ -75,7 +71,7 @@ impl SubLu {
         if self.matrix.val().iter().any(|v| !v.is_finite()) {
             return Err(LinearFailure::Numeric(None));
         }
-        numeric_lu(&self.symbolic, &mut self.numeric, self.matrix.as_ref(), &mut self.scratch).map_err(|e| match e {
+        self.lu.factor(self.matrix.as_ref()).map_err(|e| match e {
             LinearFailure::NoPivot(i) => LinearFailure::NoPivot(self.global.get(i).copied().unwrap_or(i)),
             other => other,
         })
@@ -83,7 +79,7 @@ impl SubLu {
 
     /// Solves in place for the `ncols` columns of `x` (column-major, `dim` rows).
     fn solve(&mut self, x: &mut [f64], ncols: usize) -> Result<(), LinearFailure> {
-        lu_solve(&self.symbolic, &self.numeric, &mut self.scratch, x, self.global.len(), ncols)
+        self.lu.solve(x, ncols)
     }
 }
 
@@ -224,7 +220,7 @@ impl Condensed {
     /// Factors every block (in parallel: they are independent, and each is factored
     /// sequentially, so the results do not depend on the thread count), forms `X_k` and the
     /// Schur complement (updates subtracted in block order), and factors it.
-    pub(crate) fn factor(&mut self, full: &[f64]) -> Result<(), LinearFailure> {
+    fn factor_values(&mut self, full: &[f64]) -> Result<(), LinearFailure> {
         self.schur.gather_from(full);
         self.blocks.par_iter_mut().try_for_each(|blk| blk.factor(full))?;
         let vals = self.schur.matrix.val_mut();
@@ -236,8 +232,8 @@ impl Condensed {
         self.schur.factor()
     }
 
-    /// Solves `A x = b` in place with the factors of the last [`Self::factor`].
-    pub(crate) fn solve(&mut self, x: &mut [f64]) -> Result<(), LinearFailure> {
+    /// Solves `A x = b` in place with the factors of the last [`Self::factor_values`].
+    fn solve_one(&mut self, x: &mut [f64]) -> Result<(), LinearFailure> {
         for (o, &i) in self.outer.iter().enumerate() {
             self.bo[o] = x[i];
         }
@@ -267,6 +263,17 @@ impl Condensed {
             }
         }
         Ok(())
+    }
+}
+
+impl LinearSolver for Condensed {
+    fn factor(&mut self, matrix: SparseColMatRef<'_, usize, f64>) -> Result<(), LinearFailure> {
+        self.factor_values(matrix.val())
+    }
+
+    fn solve(&mut self, x: &mut [f64], ncols: usize) -> Result<(), LinearFailure> {
+        let dim = x.len() / ncols.max(1);
+        x.chunks_mut(dim.max(1)).try_for_each(|col| self.solve_one(col))
     }
 }
 

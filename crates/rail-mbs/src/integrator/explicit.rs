@@ -31,13 +31,9 @@
 //! modally damped systems, a heuristic otherwise).
 //! The step used is `safety` × the estimate, re-estimated every `estimate_every` steps.
 
-use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::SparseColMat;
-use faer::sparse::linalg::cholesky::{
-    CholeskySymbolicParams, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
-};
-use faer::{Conj, Mat, Par, Side};
 
+use super::linear_solver::{LinearFailure, LinearSolver, SparseCholesky};
 use super::{IntegratorError, MechanicalSystem, Quantity, Stats};
 
 /// Parameters of the explicit stepper.
@@ -79,65 +75,56 @@ impl ExplicitParams {
     }
 }
 
-/// The constant mass M = M_s ⊗ I₃, factored once (sparse Cholesky, sequential, so the
-/// solve is bitwise the same for any thread count).
+/// The constant mass M = M_s ⊗ I₃, factored once with the [`SparseCholesky`] linear solver
+/// (sequential, so the solve is bitwise the same for any thread count).
 pub struct BlockMass {
-    symbolic: SymbolicCholesky<usize>,
-    l_values: Vec<f64>,
-    rhs: Mat<f64>,
-    scratch: MemBuffer,
+    chol: SparseCholesky,
+    /// The three right-hand sides, column-major (scalar index × component).
+    rhs: Vec<f64>,
 }
 
 impl std::fmt::Debug for BlockMass {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "BlockMass {{ n: {}, nnz(L): {} }}", self.rhs.nrows(), self.l_values.len())
+        write!(f, "BlockMass {{ n: {}, nnz(L): {} }}", self.rhs.len() / 3, self.chol.factor_nnz())
     }
 }
 
 impl BlockMass {
     /// Factors the scalar block `m_s` (symmetric positive definite, both triangles stored).
     pub fn new(m_s: &SparseColMat<usize, f64>) -> Result<Self, IntegratorError> {
-        let fail = |what: String| IntegratorError::InvalidSystem { what: format!("mass matrix: {what}") };
-        let n = m_s.nrows();
-        let symbolic = factorize_symbolic_cholesky(
-            m_s.symbolic(),
-            Side::Lower,
-            SymmetricOrdering::Amd,
-            CholeskySymbolicParams::default(),
-        )
-        .map_err(|e| fail(format!("{e:?}")))?;
-        let mut l_values = vec![0.0; symbolic.len_val()];
-        let req = symbolic
-            .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
-            .or(symbolic.solve_in_place_scratch::<f64>(3, Par::Seq));
-        let mut scratch = MemBuffer::new(req);
-        symbolic
-            .factorize_numeric_llt(
-                &mut l_values,
-                m_s.as_ref(),
-                Side::Lower,
-                faer::linalg::cholesky::llt::factor::LltRegularization::default(),
-                Par::Seq,
-                MemStack::new(&mut scratch),
-                Default::default(),
-            )
-            .map_err(|e| fail(format!("not positive definite ({e:?})")))?;
-        Ok(Self { symbolic, l_values, rhs: Mat::zeros(n, 3), scratch })
+        let fail = |e: LinearFailure| IntegratorError::InvalidSystem {
+            what: format!(
+                "mass matrix: {}",
+                match e {
+                    LinearFailure::Generic(m) => m,
+                    other => format!("{other:?}"),
+                }
+            ),
+        };
+        let mut chol = SparseCholesky::new(m_s.symbolic()).map_err(fail)?;
+        chol.factor(m_s.as_ref()).map_err(fail)?;
+        let mut rhs = vec![0.0; 3 * m_s.nrows()];
+        // Sizes the solve's scratch now, so that a later solve does not allocate.
+        chol.solve(&mut rhs, 3).map_err(fail)?;
+        Ok(Self { chol, rhs })
     }
 
     /// a = M⁻¹ f (coordinates 3s + k: scalar index s, component k).
     pub fn solve(&mut self, f: &[f64], a: &mut [f64]) {
-        let n = self.rhs.nrows();
+        let n = self.rhs.len() / 3;
         for s in 0..n {
             for k in 0..3 {
-                self.rhs[(s, k)] = f[3 * s + k];
+                self.rhs[s + n * k] = f[3 * s + k];
             }
         }
-        let llt = faer::sparse::linalg::cholesky::LltRef::new(&self.symbolic, &self.l_values);
-        llt.solve_in_place_with_conj(Conj::No, self.rhs.as_mut(), Par::Seq, MemStack::new(&mut self.scratch));
+        // The solve's scratch was sized in `new`, so it cannot fail; if it ever did, the
+        // accelerations are NaN, which the stepper's finiteness check reports.
+        if self.chol.solve(&mut self.rhs, 3).is_err() {
+            self.rhs.fill(f64::NAN);
+        }
         for s in 0..n {
             for k in 0..3 {
-                a[3 * s + k] = self.rhs[(s, k)];
+                a[3 * s + k] = self.rhs[s + n * k];
             }
         }
     }

@@ -14,7 +14,11 @@
 //! matrix–vector product runs row-wise over a CSR copy of the values, in parallel with
 //! a fixed partition, so results do not depend on the thread count.
 
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use rayon::prelude::*;
+
+use super::error::KktIndex;
+use super::linear_solver::{LinearFailure, LinearSolver};
 
 /// Parameters of the iterative Newton-matrix solver.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -68,6 +72,75 @@ impl IterativeParams {
             return Err(("iterative.rel_tol", self.rel_tol, "(0, 1)"));
         }
         Ok(())
+    }
+}
+
+/// The iterative [`LinearSolver`]: restarted GMRES, right-preconditioned by block Jacobi
+/// ("factoring" inverts the diagonal blocks), from a zero initial guess. Not exact: a solve
+/// fails unless GMRES reaches `params.rel_tol` within `params.max_iterations`.
+pub(crate) struct Krylov {
+    params: IterativeParams,
+    csr: CsrView,
+    prec: BlockJacobi,
+    gmres: Gmres,
+    /// Copy of the right-hand side (GMRES overwrites `x`).
+    rhs: Vec<f64>,
+    iterations: usize,
+}
+
+impl Krylov {
+    /// `params` must be valid ([`IterativeParams::validate`]).
+    pub(crate) fn new(params: IterativeParams, pattern: SymbolicSparseColMatRef<'_, usize>) -> Self {
+        let dim = pattern.nrows();
+        Self {
+            params,
+            csr: CsrView::from_csc(dim, pattern.col_ptr(), pattern.row_idx()),
+            prec: BlockJacobi::new(dim, params.block),
+            gmres: Gmres::new(dim, params.restart.min(dim.max(1))),
+            rhs: vec![0.0; dim],
+            iterations: 0,
+        }
+    }
+}
+
+impl LinearSolver for Krylov {
+    fn factor(&mut self, matrix: SparseColMatRef<'_, usize, f64>) -> Result<(), LinearFailure> {
+        self.csr.gather(matrix.val());
+        self.prec.factor(&self.csr).map_err(LinearFailure::NoPivot)
+    }
+
+    /// A non-finite entry is reported by its index (the system is unconstrained, so every
+    /// unknown is a coordinate).
+    fn solve(&mut self, x: &mut [f64], ncols: usize) -> Result<(), LinearFailure> {
+        let dim = self.rhs.len();
+        for col in x.chunks_mut(dim.max(1)).take(ncols) {
+            self.rhs.copy_from_slice(col);
+            col.fill(0.0);
+            let report = self.gmres.solve(
+                &self.csr,
+                &self.prec,
+                &self.rhs,
+                col,
+                self.params.rel_tol,
+                self.params.max_iterations,
+            );
+            self.iterations += report.iterations;
+            if let Some(i) = col.iter().position(|v| !v.is_finite()) {
+                return Err(LinearFailure::Numeric(Some(KktIndex::from_raw(i, dim))));
+            }
+            if !report.converged {
+                return Err(LinearFailure::Numeric(None));
+            }
+        }
+        Ok(())
+    }
+
+    fn exact(&self) -> bool {
+        false
+    }
+
+    fn iterations(&self) -> usize {
+        self.iterations
     }
 }
 

@@ -9,34 +9,18 @@
 //!
 //! Its pattern (the union of the dynamics pattern, the diagonal, `C_q` and `C_qᵀ`) is
 //! fixed when the solver is built; [`KktSolver::assemble`] writes values through a
-//! precomputed map into the CSC value array. The LU goes through faer's low-level API
-//! with a persistent [`NumericLu`] and a persistent scratch [`MemBuffer`], so neither a
-//! solve nor (after the first) a numeric refactorization allocates.
+//! precomputed map into the CSC value array, and the [`LinearSolver`] the scenario chose
+//! (sparse LU, condensation or GMRES: [`super::linear_solver`]) factors and solves it.
 
-use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
-use faer::sparse::linalg::LuError;
-use faer::sparse::linalg::lu::{NumericLu, SymbolicLu, factorize_symbolic_lu};
 use faer::sparse::{Pair, SparseColMat, SymbolicSparseColMat};
-use faer::{Conj, MatMut, Par};
 
-use super::condensed::Condensed;
 use super::error::KktIndex;
-use super::iterative::{BlockJacobi, CsrView, Gmres, IterativeParams, LinearSolverKind};
+use super::iterative::LinearSolverKind;
+pub(crate) use super::linear_solver::LinearFailure;
+use super::linear_solver::{LinearSolver, for_kkt};
 use super::system::SparsityPattern;
 
-/// Why a factorization or solve failed (converted to an
-/// [`IntegratorError`](super::IntegratorError) by the caller, who knows `t` and `h`).
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) enum LinearFailure {
-    /// faer found no pivot (structurally singular) at this elimination step.
-    NoPivot(usize),
-    /// Solution non-finite or residual check failed; first bad unknown if any.
-    Numeric(Option<KktIndex>),
-    /// Allocation / index overflow inside faer.
-    Generic(String),
-}
-
-/// Sparse KKT matrix with its symbolic LU and the latest numeric LU.
+/// Sparse KKT matrix, its fixed pattern and the [`LinearSolver`] the scenario chose.
 pub(crate) struct KktSolver {
     n: usize,
     m: usize,
@@ -45,7 +29,9 @@ pub(crate) struct KktSolver {
     dyn_pos: Vec<usize>,
     /// CSC value positions of each `C_q` entry: `(n + k, j)` and `(j, n + k)`.
     cq_pos: Vec<(usize, usize)>,
-    backend: Backend,
+    solver: Box<dyn LinearSolver>,
+    /// Whether `solver` holds the factors of the current values.
+    factored: bool,
     /// Copy of the right-hand side for the residual check.
     rhs_copy: Vec<f64>,
     /// Residual / refinement buffer.
@@ -54,59 +40,6 @@ pub(crate) struct KktSolver {
     residual_tol: f64,
     /// Largest absolute matrix entry at the last factorization.
     a_max: f64,
-    /// Scratch of the factorization and the solves (grown on demand, then reused).
-    scratch: Scratch,
-}
-
-/// A reusable faer scratch buffer that grows to the largest requirement seen.
-pub(crate) struct Scratch {
-    req: StackReq,
-    buffer: MemBuffer,
-}
-
-impl Scratch {
-    pub(crate) fn new() -> Self {
-        Self { req: StackReq::EMPTY, buffer: MemBuffer::new(StackReq::EMPTY) }
-    }
-
-    /// A stack of at least `req`; allocates only when `req` exceeds every earlier one.
-    pub(crate) fn stack(&mut self, req: StackReq) -> Result<&mut MemStack, LinearFailure> {
-        let grown = self.req.or(req);
-        if grown != self.req {
-            self.buffer = MemBuffer::try_new(grown).map_err(|e| LinearFailure::Generic(format!("{e:?}")))?;
-            self.req = grown;
-        }
-        Ok(MemStack::new(&mut self.buffer))
-    }
-}
-
-/// The parallelism of the factorization and the solves: sequential, always. faer's
-/// supernodal LU splits its work by the number of rayon threads, so with its global
-/// setting the last bits of the solution (and so the trajectories) changed with
-/// `RAYON_NUM_THREADS` on the 6×4×2 tank-car mesh; sequential, they do not
-/// (`fluid_car_results_do_not_depend_on_the_thread_count`). The LU of these KKT matrices
-/// gained nothing measurable from threads (`docs/benchmarks.md`).
-fn parallelism() -> Par {
-    Par::Seq
-}
-
-/// The factorization behind [`KktSolver`].
-enum Backend {
-    /// Sparse LU: symbolic factorization once, numeric LU per refresh (into the same
-    /// [`NumericLu`], whose storage is reused); `factored` when it holds a valid LU.
-    Direct { symbolic: Box<SymbolicLu<usize>>, numeric: Box<NumericLu<usize, f64>>, factored: bool },
-    /// Static condensation of the system's independent blocks onto the rest
-    /// ([`super::condensed`]); `factored` when its factors are valid.
-    Condensed { cond: Box<Condensed>, factored: bool },
-    /// GMRES with block Jacobi: "factorizing" inverts the diagonal blocks.
-    Iterative {
-        params: IterativeParams,
-        csr: CsrView,
-        prec: BlockJacobi,
-        gmres: Box<Gmres>,
-        factored: bool,
-        iterations: usize,
-    },
 }
 
 impl KktSolver {
@@ -129,8 +62,8 @@ impl KktSolver {
             pairs.push(Pair { row: n + k, col: j });
             pairs.push(Pair { row: j, col: n + k });
         }
-        let (symbolic, _argsort) = SymbolicSparseColMat::try_new_from_indices(dim, dim, &pairs)
-            .map_err(|e| LinearFailure::Generic(format!("{e:?}")))?;
+        let (symbolic, _argsort) =
+            SymbolicSparseColMat::try_new_from_indices(dim, dim, &pairs).map_err(LinearFailure::generic)?;
         let pos = |row: usize, col: usize| -> usize {
             let start = symbolic.col_ptr()[col];
             let rows = &symbolic.row_idx()[start..symbolic.col_ptr()[col + 1]];
@@ -141,57 +74,19 @@ impl KktSolver {
         let cq_pos = pattern.constraints.iter().map(|&(k, j)| (pos(n + k, j), pos(j, n + k))).collect();
         let nnz = symbolic.row_idx().len();
         let matrix = SparseColMat::new(symbolic, vec![0.0; nnz]);
-        let kind =
-            if kind == LinearSolverKind::Condensed && blocks.is_empty() { LinearSolverKind::Direct } else { kind };
-        let backend = match kind {
-            LinearSolverKind::Condensed => {
-                let sym = matrix.symbolic();
-                Backend::Condensed {
-                    cond: Box::new(Condensed::new(dim, sym.col_ptr(), sym.row_idx(), blocks)?),
-                    factored: false,
-                }
-            }
-            LinearSolverKind::Direct => Backend::Direct {
-                symbolic: Box::new(
-                    factorize_symbolic_lu(matrix.symbolic(), Default::default())
-                        .map_err(|e| LinearFailure::Generic(format!("{e:?}")))?,
-                ),
-                numeric: Box::new(NumericLu::new()),
-                factored: false,
-            },
-            LinearSolverKind::Iterative(params) => {
-                if m > 0 {
-                    return Err(LinearFailure::Generic(format!(
-                        "the iterative linear solver needs an unconstrained system; this one has {m} constraints \
-                         (use LinearSolverKind::Direct)"
-                    )));
-                }
-                params.validate().map_err(|(field, value, allowed)| {
-                    LinearFailure::Generic(format!("invalid parameter `{field}` = {value}: allowed {allowed}"))
-                })?;
-                let sym = matrix.symbolic();
-                Backend::Iterative {
-                    params,
-                    csr: CsrView::from_csc(dim, sym.col_ptr(), sym.row_idx()),
-                    prec: BlockJacobi::new(dim, params.block),
-                    gmres: Box::new(Gmres::new(dim, params.restart.min(dim.max(1)))),
-                    factored: false,
-                    iterations: 0,
-                }
-            }
-        };
+        let solver = for_kkt(kind, matrix.symbolic(), m, blocks)?;
         Ok(Self {
             n,
             m,
             matrix,
             dyn_pos,
             cq_pos,
-            backend,
+            solver,
+            factored: false,
             rhs_copy: vec![0.0; dim],
             work: vec![0.0; dim],
             residual_tol,
             a_max: 0.0,
-            scratch: Scratch::new(),
         })
     }
 
@@ -202,10 +97,7 @@ impl KktSolver {
 
     /// Total Krylov iterations of the iterative backend so far (0 for the direct one).
     pub(crate) fn linear_iterations(&self) -> usize {
-        match &self.backend {
-            Backend::Direct { .. } | Backend::Condensed { .. } => 0,
-            Backend::Iterative { iterations, .. } => *iterations,
-        }
+        self.solver.iterations()
     }
 
     /// Writes `c_m M − c_v Dv − c_q Dq` and `C_q`, `C_qᵀ` into the matrix values.
@@ -228,61 +120,32 @@ impl KktSolver {
         }
     }
 
-    /// Numeric LU of the current values, reusing the symbolic factorization.
+    /// Factors the current values with the chosen solver (its symbolic analysis was done
+    /// when it was built).
     pub(crate) fn factorize(&mut self) -> Result<(), LinearFailure> {
-        match &mut self.backend {
-            Backend::Direct { factored, .. }
-            | Backend::Condensed { factored, .. }
-            | Backend::Iterative { factored, .. } => *factored = false,
-        }
+        self.factored = false;
         if self.matrix.val().iter().any(|v| !v.is_finite()) {
             return Err(LinearFailure::Numeric(None));
         }
         self.a_max = inf_norm(self.matrix.val());
-        let (symbolic, numeric, factored) = match &mut self.backend {
-            Backend::Direct { symbolic, numeric, factored } => (symbolic, numeric, factored),
-            Backend::Condensed { cond, factored } => {
-                cond.factor(self.matrix.val())?;
-                *factored = true;
-                return Ok(());
-            }
-            Backend::Iterative { csr, prec, factored, .. } => {
-                csr.gather(self.matrix.val());
-                prec.factor(csr).map_err(LinearFailure::NoPivot)?;
-                *factored = true;
-                return Ok(());
-            }
-        };
-        numeric_lu(symbolic, numeric, self.matrix.as_ref(), &mut self.scratch)?;
-        *factored = true;
+        self.solver.factor(self.matrix.as_ref())?;
+        self.factored = true;
         Ok(())
     }
 
-    /// Solves `A x = b` in place (`rhs` holds `b` on entry, `x` on exit), checks
-    /// finiteness and the relative residual, and does up to one step of iterative
-    /// refinement if the residual is too large.
+    /// Solves `A x = b` in place (`rhs` holds `b` on entry, `x` on exit). An exact solver's
+    /// result is checked for finiteness and its relative residual, with up to one step of
+    /// iterative refinement if the residual is too large; an iterative one checks its own.
     pub(crate) fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearFailure> {
-        let dim = self.n + self.m;
-        match &mut self.backend {
-            Backend::Direct { factored: false, .. }
-            | Backend::Condensed { factored: false, .. }
-            | Backend::Iterative { factored: false, .. } => {
-                return Err(LinearFailure::Numeric(None));
-            }
-            Backend::Iterative { params, csr, prec, gmres, iterations, .. } => {
-                self.rhs_copy.copy_from_slice(rhs);
-                rhs.fill(0.0);
-                let report = gmres.solve(csr, prec, &self.rhs_copy, rhs, params.rel_tol, params.max_iterations);
-                *iterations += report.iterations;
-                if let Some(i) = rhs.iter().position(|v| !v.is_finite()) {
-                    return Err(LinearFailure::Numeric(Some(KktIndex::from_raw(i, self.n))));
-                }
-                return if report.converged { Ok(()) } else { Err(LinearFailure::Numeric(None)) };
-            }
-            Backend::Direct { .. } | Backend::Condensed { .. } => {}
+        if !self.factored {
+            return Err(LinearFailure::Numeric(None));
         }
+        if !self.solver.exact() {
+            return self.solver.solve(rhs, 1);
+        }
+        let dim = self.n + self.m;
         self.rhs_copy.copy_from_slice(rhs);
-        apply_inverse(&mut self.backend, &mut self.scratch, dim, rhs)?;
+        self.solver.solve(rhs, 1)?;
         for refinement in 0..2 {
             if let Some(i) = rhs.iter().position(|v| !v.is_finite()) {
                 return Err(LinearFailure::Numeric(Some(KktIndex::from_raw(i, self.n))));
@@ -306,70 +169,12 @@ impl KktSolver {
             if refinement == 1 {
                 break;
             }
-            apply_inverse(&mut self.backend, &mut self.scratch, dim, &mut self.work)?;
+            self.solver.solve(&mut self.work, 1)?;
             for (x, d) in rhs.iter_mut().zip(&self.work) {
                 *x += d;
             }
         }
         Err(LinearFailure::Numeric(None))
-    }
-}
-
-/// Numeric sparse LU of `matrix` into `numeric` with the symbolic factorization `symbolic`
-/// (the direct backend and every block of the condensed one). faer 0.24 can panic on some zero
-/// pivots (faer-rs issue #232): that becomes an error instead of unwinding through the
-/// integrator. `NoPivot` carries faer's column index in `matrix`.
-pub(crate) fn numeric_lu(
-    symbolic: &SymbolicLu<usize>,
-    numeric: &mut NumericLu<usize, f64>,
-    matrix: faer::sparse::SparseColMatRef<'_, usize, f64>,
-    scratch: &mut Scratch,
-) -> Result<(), LinearFailure> {
-    let par = parallelism();
-    let stack = scratch.stack(symbolic.factorize_numeric_lu_scratch::<f64>(par, Default::default()))?;
-    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        symbolic.factorize_numeric_lu(numeric, matrix, par, stack, Default::default()).map(|_| ())
-    }));
-    // faer's dense kernels leave the vector registers dirty (`ancf_core::simd`).
-    ancf_core::clear_upper_simd();
-    if !matches!(result, Ok(Ok(()))) {
-        // Failed or unwound mid-factorization: start the next one from an empty numeric
-        // LU rather than from a partly written one (allocates again, on failures only).
-        *numeric = NumericLu::new();
-    }
-    match result {
-        Ok(Ok(())) => Ok(()),
-        Ok(Err(LuError::SymbolicSingular { index })) => Err(LinearFailure::NoPivot(index)),
-        Ok(Err(LuError::Generic(e))) => Err(LinearFailure::Generic(format!("{e:?}"))),
-        Err(_) => Err(LinearFailure::Numeric(None)),
-    }
-}
-
-/// `x ← A⁻¹ x` for the `ncols` columns of `x` (column-major, `dim` rows) with a numeric LU
-/// from [`numeric_lu`] (the caller knows it succeeded).
-pub(crate) fn lu_solve(
-    symbolic: &SymbolicLu<usize>,
-    numeric: &NumericLu<usize, f64>,
-    scratch: &mut Scratch,
-    x: &mut [f64],
-    dim: usize,
-    ncols: usize,
-) -> Result<(), LinearFailure> {
-    let par = parallelism();
-    let stack = scratch.stack(symbolic.solve_in_place_scratch::<f64>(ncols, par))?;
-    let lu = faer::sparse::linalg::lu::LuRef::new_unchecked(symbolic, numeric);
-    lu.solve_in_place_with_conj(Conj::No, MatMut::from_column_major_slice_mut(x, dim, ncols), par, stack);
-    ancf_core::clear_upper_simd();
-    Ok(())
-}
-
-/// `x ← A⁻¹ x` with the factors of a direct or condensed backend.
-fn apply_inverse(backend: &mut Backend, scratch: &mut Scratch, dim: usize, x: &mut [f64]) -> Result<(), LinearFailure> {
-    match backend {
-        // `factored` was checked by the caller
-        Backend::Direct { symbolic, numeric, .. } => lu_solve(symbolic, numeric, scratch, x, dim, 1),
-        Backend::Condensed { cond, .. } => cond.solve(x),
-        Backend::Iterative { .. } => Err(LinearFailure::Generic("apply_inverse: iterative backend".into())),
     }
 }
 
@@ -380,6 +185,7 @@ fn inf_norm(x: &[f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::integrator::IterativeParams;
 
     /// 3 coordinates, 1 constraint: checks value mapping against a dense product and
     /// the solve.

@@ -135,6 +135,7 @@ mod hht;
 mod iterative;
 mod journal;
 mod linear;
+mod linear_solver;
 mod params;
 mod stats;
 mod system;
