@@ -46,7 +46,7 @@ impl LinearFailure {
 }
 
 /// A linear solver for sparse matrices of one fixed pattern (given when it is built).
-pub(crate) trait LinearSolver: Send {
+pub(crate) trait LinearSolver: Send + Sync {
     /// Factors (or, for an iterative solver, preconditions) the matrix's current values.
     fn factor(&mut self, matrix: SparseColMatRef<'_, usize, f64>) -> Result<(), LinearFailure>;
     /// `x ← A⁻¹ x` for the `ncols` columns of `x` (column-major) with the last factors.
