@@ -126,3 +126,117 @@ def test_vtu_snapshots_and_pvd_collection(fluid_run, tmp_path):
     assert results.write_vtu({"snapshots": []}, tmp_path, fluid_run["connectivity"]) is None
     with pytest.raises(ValueError, match="invalid parameter `connectivity`"):
         results.write_vtu(fluid_run, tmp_path, np.zeros((2, 4), dtype=int))
+
+
+# --- the settling phase (issue 19) ----------------------------------------------------------------
+
+
+def _startup(w=340e3, cars=2, t_end=2.0, n=1001):
+    """A fluid-vehicle-like run: each tank's vertical load released from zero overshoots to about
+    1.7 x the weight (the start-up spike), then braking loads the tank longitudinally from 0.5 s."""
+    t = np.linspace(0.0, t_end, n)
+    f = np.zeros((n, cars, 3))
+    f[:, :, 2] = (-w * (1 - np.exp(-t / 0.03) * np.cos(2 * np.pi * 50 * t)))[:, None]
+    f[:, :, 0] = np.where(t > 0.5, 0.1 * w * np.sin(np.pi * (t - 0.5) / (t_end - 0.5)), 0.0)[:, None]
+    return t, f
+
+
+def test_settling_is_detected_from_the_liquid_vertical_load():
+    t, f = _startup()
+    ds = results.to_dataset({"t": t, "fluid_force_tank": f})
+    s = results.settling(ds)
+    # the envelope exp(-t/0.03) falls below 5 % at 0.09 s: the 0.1 s quiet window starts about there
+    assert s.source == "detected" and 0.05 < s.time < 0.1
+    assert "5%" in s.rule and results.settling_time(ds) == s.time == results.settling(ds).time  # deterministic
+    part = results.after_settling(ds)
+    assert float(part["time"][0]) >= s.time and float(part["time"][-1]) == 2.0
+    # peaks and statistics leave the start-up spike out unless asked
+    z_all = next(p for p in results.peaks(ds, include_settling=True) if p.component == "z")
+    z = next(p for p in results.peaks(ds) if p.component == "z")
+    assert z_all.value < -1.6 * 340e3 and z_all.time < 0.02
+    assert abs(z.value) < 1.06 * 340e3 and z.time >= s.time and z.after == s.time
+    x = next(p for p in results.peaks(ds) if p.component == "x")
+    assert x.value == pytest.approx(0.1 * 340e3, rel=1e-3) and x.where == {"car": 1}
+    st = {(r.name, r.component): r for r in results.statistics(ds)}
+    assert st["fluid_force_tank", "z"].min > -1.06 * 340e3 and st["fluid_force_tank", "z"].after == s.time
+    st_all = {(r.name, r.component): r for r in results.statistics(ds, include_settling=True)}
+    assert st_all["fluid_force_tank", "z"].min < -1.6 * 340e3
+
+
+def test_a_declared_or_settled_start_replaces_detection():
+    t, f = _startup()
+    ds = results.to_dataset({"t": t, "fluid_force_tank": f})
+    ds.attrs["settle_time"] = 0.5
+    assert results.settling(ds) == results.Settling(0.5, "declared", "declared: the scene's settling time 0.5 s")
+    ds.attrs["settle_time"] = 99.0  # beyond the run: the whole run
+    assert results.settling_time(ds) == 2.0
+    ds.attrs["settle_time"] = -1.0
+    with pytest.raises(ValueError, match="invalid attribute `settle_time`"):
+        results.settling(ds)
+    del ds.attrs["settle_time"]
+    for flag in (1, "true", np.int8(1)):
+        ds.attrs["settled_start"] = flag
+        assert results.settling(ds).time == 0.0 and results.settling(ds).source == "settled start"
+    ds.attrs["settled_start"] = 0
+    assert results.settling(ds).source == "detected"
+
+
+def test_runs_without_a_start_up_transient_have_no_settling():
+    t = np.linspace(0.0, 1.0, 201)
+    f = np.zeros((len(t), 3))
+    f[:, 2] = -137.0 * (1 + 0.01 * np.sin(2 * np.pi * 3 * t))  # at rest from the start
+    ds = results.to_dataset({"t": t, "force_tank": f})
+    assert results.settling(ds).time == 0.0
+    # no liquid (rigid lading): nothing to detect from, the run starts from its static equilibrium
+    ds = results.to_dataset({"t": t, "coupler_force": np.ones((len(t), 1))})
+    assert results.settling(ds) == results.Settling(0.0, "none", results.settling(ds).rule)
+
+
+def test_an_excitation_before_the_liquid_has_settled_ends_settling_where_the_startup_is_quietest():
+    t = np.linspace(0.0, 2.0, 2001)
+    f = np.zeros((len(t), 3))
+    f[:, 2] = -137.0 * (1 - np.exp(-t / 0.05) * np.cos(2 * np.pi * 40 * t))
+    f[t >= 0.2, 2] -= 137.0 * 3 * np.sin(np.pi * (t[t >= 0.2] - 0.2) / 0.3) * (t[t >= 0.2] < 0.5)  # a bump at 0.2 s
+    ds = results.to_dataset({"t": t, "force_tank": f})
+    s = results.settling(ds)
+    assert s.source == "detected" and "never stays within" in s.rule
+    assert 0.05 < s.time < 0.2, "ends before the bump, after the start-up spike"
+
+
+def test_extreme_finds_largest_smallest_and_largest_magnitude():
+    t = np.linspace(0.0, 1.0, 11)
+    c = np.stack([np.sin(2 * np.pi * t), -3 * t], axis=1)
+    ds = results.to_dataset({"t": t, "coupler_force": c})
+    da = ds["coupler_force"]
+    lo, hi = results.extreme(da, mode="min"), results.extreme(da, mode="max")
+    assert lo.value == pytest.approx(-3.0) and lo.where == {"coupler": 2} and lo.time == 1.0
+    assert hi.value == pytest.approx(np.sin(2 * np.pi * 0.2)) and hi.time == pytest.approx(0.2)
+    assert results.extreme(da, after=0.55).time == pytest.approx(1.0)
+    with pytest.raises(ValueError, match="invalid parameter `mode`"):
+        results.extreme(da, mode="mean")
+
+
+def test_loading_a_file_that_is_not_netcdf_is_a_clear_error(tmp_path):
+    bad = tmp_path / "results.nc"
+    bad.write_text("this is not netCDF\n")
+    with pytest.raises(ValueError, match=r"invalid results file `.*results\.nc`: not a netCDF file"):
+        results.load(bad)
+    with pytest.raises(FileNotFoundError, match="no such file"):
+        results.load(tmp_path / "missing.nc")
+    with pytest.raises(FileNotFoundError, match="a directory"):
+        results.load(tmp_path)
+
+
+def test_a_run_or_scene_declares_its_settling_phase_through_to_dataset():
+    t, f = _startup()
+    ds = results.to_dataset({"t": t, "fluid_force_tank": f, "settle_time": 0.5})
+    assert ds.attrs["settle_time"] == 0.5 and results.settling(ds).source == "declared"
+
+    class Scene:
+        kind, name, settle_time, settled_start = "fluid_vehicle", "declared", None, True
+
+        def to_dict(self):
+            return {}
+
+    ds = results.to_dataset({"t": t, "fluid_force_tank": f}, Scene())
+    assert ds.attrs["settled_start"] == 1 and results.settling(ds).time == 0.0

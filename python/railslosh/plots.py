@@ -1,102 +1,401 @@
-"""PNG plots of a results Dataset (:func:`railslosh.results.to_dataset`), drawn with matplotlib's
-Agg backend (no display needed).
+"""PNG plots of a results Dataset (:func:`railslosh.results.to_dataset`), for an engineer's eye:
+engineering units (kN, mm, km/h) chosen by magnitude, axis labels in words, one panel per car or
+per component where lines would overlap, a legend entry per line (wheel loads: car, wheelset and
+side), the limits a standard gives drawn in (L/V, wheel unloading), and the settling phase
+(:func:`railslosh.results.settling`) shaded grey. Every figure is drawn inside the matplotlib style
+:data:`STYLE` (``railslosh.mplstyle``), with the Agg canvas (no display needed).
 
     >>> from railslosh import plots, results
     >>> paths = plots.plot_dataset(results.load("out/results.nc"), "out/plots")
+    >>> fig = plots.figure(ds, "wheel_loads")          # the matplotlib Figure, not saved
 """
 
 from __future__ import annotations
 
+import json
+import math
 import os
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-__all__ = ["PLOTS", "plot_dataset"]
+__all__ = [
+    "FLANGE_ANGLE",
+    "LABELS",
+    "L_OVER_V_LIMIT",
+    "PLOTS",
+    "UNLOADING_LIMIT",
+    "display_unit",
+    "figure",
+    "label",
+    "limits",
+    "nadal_limit",
+    "peak_table",
+    "plot_dataset",
+]
 
-# (file stem, title, variables); each variable is drawn per car / wheelset / component.
-PLOTS: tuple[tuple[str, str, tuple[str, ...]], ...] = (
-    ("coupler_force", "Coupler forces (tension positive)", ("coupler_force",)),
-    ("fluid_force", "Force of the liquid on each tank (tank frame)", ("fluid_force_tank",)),
-    ("oil_com", "Liquid centre of mass (tank frame)", ("oil_com_tank",)),
-    ("wheel_loads", "Vertical wheel loads Q", ("wheel_vertical",)),
-    ("l_over_v", "Derailment quotient L/V", ("l_over_v",)),
-    ("speed", "Tank speed", ("tank_speed",)),
-    ("slosh_force", "Force of the liquid on the tank (tank frame)", ("force_tank",)),
-    ("slosh_moment", "Moment of the liquid on the tank (tank frame)", ("moment_tank",)),
-    ("slosh_com", "Liquid centre of mass (tank frame)", ("com_tank",)),
-    ("energy", "Energies of the liquid", ("kinetic_energy", "potential_energy")),
+STYLE = Path(__file__).with_name("railslosh.mplstyle")
+"""The matplotlib style file of every railslosh figure (``matplotlib.style.context(STYLE)``)."""
+
+# The one place where a variable becomes words: name -> (label, short label, quantity). The
+# quantity picks the display unit (:func:`display_unit`); one name per concept, so the liquid's
+# force is "Liquid force on the tank" whether a slosh or a vehicle run recorded it.
+LABELS: dict[str, tuple[str, str, str]] = {
+    "wheel_vertical": ("Vertical wheel load Q", "Wheel load Q", "force"),
+    "wheel_lateral": ("Lateral wheel force Y", "Lateral wheel force Y", "force"),
+    "l_over_v": ("Derailment quotient L/V = |Y|/Q", "L/V", "ratio"),
+    "unloading": ("Wheel unloading ΔQ/Q₀", "ΔQ/Q₀", "ratio"),
+    "wheelset_lateral": ("Wheelset lateral displacement", "Lateral displacement", "length"),
+    "coupler_force": ("Coupler force", "Coupler force", "force"),
+    "tank_station": ("Tank position along the track", "Position", "distance"),
+    "tank_speed": ("Speed", "Speed", "speed"),
+    "oil_com_tank": ("Liquid centre of mass", "position", "length"),
+    "oil_com_global": ("Liquid centre of mass", "position", "distance"),
+    "fluid_force_tank": ("Liquid force on the tank", "force", "force"),
+    "volume_error": ("Liquid volume change", "Volume change", "percent"),
+    "slosh_displacement": ("Slosh mass displacement", "Displacement", "length"),
+    "force_tank": ("Liquid force on the tank", "force", "force"),
+    "moment_tank": ("Liquid moment on the tank", "moment", "moment"),
+    "force_global": ("Liquid force on the tank", "force", "force"),
+    "moment_global": ("Liquid moment on the tank", "moment", "moment"),
+    "com_tank": ("Liquid centre of mass", "position", "length"),
+    "volume": ("Liquid volume", "Volume", "volume"),
+    "kinetic_energy": ("Kinetic energy of the liquid", "Kinetic energy", "energy"),
+    "potential_energy": ("Potential energy of the liquid", "Potential energy", "energy"),
+    "newton_iterations": ("Newton iterations per step", "Iterations", "count"),
+    "max_penetration": ("Largest wall penetration", "Penetration", "length"),
+    "stored_energy": ("Stored elastic energy of the liquid", "Stored energy", "energy"),
+    "input_work": ("Work put into the liquid", "Input work", "energy"),
+    "energy_error": ("Energy growth ε (≤ 0 physical)", "ε", "ratio"),
+    "min_volume_ratio": ("Smallest volume ratio J", "J", "ratio"),
+    "containment_gap": ("Largest gap beyond a wall", "Gap", "length"),
+}
+
+# quantity -> ((unit, factor from SI, used from this |SI value| up), ...), smallest first
+_UNITS: dict[str, tuple[tuple[str, float, float], ...]] = {
+    "force": (("N", 1.0, 0.0), ("kN", 1e-3, 1e3)),
+    "moment": (("N m", 1.0, 0.0), ("kN m", 1e-3, 1e3)),
+    "energy": (("J", 1.0, 0.0), ("kJ", 1e-3, 1e4), ("MJ", 1e-6, 1e7)),
+    "length": (("mm", 1e3, 0.0), ("m", 1.0, 1.0)),
+    "distance": (("m", 1.0, 0.0), ("km", 1e-3, 1e4)),
+    "speed": (("km/h", 3.6, 0.0),),
+    "ratio": (("", 1.0, 0.0),),
+    "percent": (("%", 100.0, 0.0),),
+    "volume": (("L", 1e3, 0.0), ("m³", 1.0, 1.0)),
+    "count": (("", 1.0, 0.0),),
+}
+
+# quantity -> smallest y range drawn (SI): below it a series is round-off about a constant and is
+# drawn flat (a wheelset on straight track moves by nanometres, not by "1e-6 mm" of full scale)
+_RESOLUTION = {
+    "force": 1.0,
+    "moment": 0.1,
+    "energy": 1e-3,
+    "length": 1e-4,
+    "distance": 1e-2,
+    "speed": 1e-3,
+    "ratio": 1e-3,
+    "percent": 1e-5,
+    "volume": 1e-6,
+    "count": 1.0,
+}
+
+_AXES = {"x": "Longitudinal", "y": "Lateral", "z": "Vertical"}
+_ROTATIONS = {"x": "Roll", "y": "Pitch", "z": "Yaw"}
+
+# Derailment quotient limit (Y/Q)lim = 0.8: UIC 518 (4th ed., 2009) and EN 14363:2016, where it
+# applies to the 2 m sliding mean of Y/Q; the plots show the unfiltered quotient against it.
+L_OVER_V_LIMIT = 0.8
+_L_OVER_V_SOURCE = "UIC 518, EN 14363"
+# Wheel unloading limit ΔQ/Q₀ = 0.6: UIC 530-2 and EN 14363:2016 (safety against derailment on
+# twisted track, quasi-static wheel unloading).
+UNLOADING_LIMIT = 0.6
+_UNLOADING_SOURCE = "UIC 530-2, EN 14363"
+# Flange angles of the wheel profiles (deg): S1002 (EN 13715) 70°, the AAR-1B-style profile 75°
+# (rail_mbs::profile::analytic), for Nadal's single-wheel flange-climb limit.
+FLANGE_ANGLE = {"s1002": 70.0, "aar1b": 75.0}
+
+
+def nadal_limit(flange_angle: float = 70.0, friction: float = 0.5) -> float:
+    """Nadal's flange-climb limit Y/Q = (tan δ − μ)/(1 + μ tan δ) for flange angle δ (deg) and
+    flange friction μ (0.5: dry rail, conservative); 0.95 for 70° and μ = 0.5."""
+    tan = math.tan(math.radians(flange_angle))
+    return (tan - friction) / (1.0 + friction * tan)
+
+
+def label(name: str) -> str:
+    """The variable in words (:data:`LABELS`), or its ``long_name``-free name when unknown."""
+    return LABELS.get(name, (name.replace("_", " ").capitalize(), "", ""))[0]
+
+
+def display_unit(name: str, values: Any = None, units: str = "") -> tuple[str, float]:
+    """``(unit, factor)`` to show variable ``name`` in (SI value × factor): kN for forces from
+    1 kN, mm for lengths below 1 m, km/h for speeds, ... (:data:`LABELS` quantity), by the
+    largest finite ``|values|``. Unknown variables keep their SI ``units``."""
+    quantity = LABELS.get(name, ("", "", ""))[2]
+    if quantity not in _UNITS:
+        return units, 1.0
+    v = np.abs(np.asarray(values if values is not None else [0.0], dtype=float))
+    big = float(np.nanmax(v)) if np.isfinite(v).any() else 0.0
+    chosen = _UNITS[quantity][0]
+    for entry in _UNITS[quantity]:
+        if big >= entry[2]:
+            chosen = entry
+    return chosen[0], chosen[1]
+
+
+def _with_unit(text: str, unit: str) -> str:
+    return f"{text} ({unit})" if unit else text
+
+
+def _profile(ds: Any) -> str:
+    try:
+        return str(json.loads(ds.attrs.get("scene_json", "{}")).get("car", {}).get("wheel_profile", "s1002"))
+    except (ValueError, AttributeError):
+        return "s1002"
+
+
+def limits(ds: Any, name: str) -> list[tuple[float, str, str]]:
+    """``(value in SI units, legend label, line style)`` of the standard limits of variable
+    ``name``: L/V (UIC 518 / EN 14363 and Nadal for the run's wheel profile), wheel unloading
+    (UIC 530-2 / EN 14363) and, for wheel loads, the load at that unloading and the static load.
+    Dataset attributes ``l_over_v_limit`` and ``unloading_limit`` replace the defaults."""
+    unloading = float(ds.attrs.get("unloading_limit", UNLOADING_LIMIT))
+    if name == "l_over_v":
+        lv = float(ds.attrs.get("l_over_v_limit", L_OVER_V_LIMIT))
+        prof = _profile(ds)
+        angle = FLANGE_ANGLE.get(prof, 70.0)
+        return [
+            (lv, f"limit {lv:g} ({_L_OVER_V_SOURCE})", "--"),
+            (nadal_limit(angle), f"Nadal {nadal_limit(angle):.2f} ({prof}, δ = {angle:g}°, μ = 0.5)", ":"),
+        ]
+    if name == "unloading":
+        return [(unloading, f"limit {unloading:g} ({_UNLOADING_SOURCE})", "--")]
+    q0 = ds.attrs.get("static_wheel_load")
+    if name == "wheel_vertical" and q0 is not None:
+        q0 = float(q0)
+        return [
+            (q0, "static load Q₀", ":"),
+            ((1 - unloading) * q0, f"ΔQ/Q₀ = {unloading:g} ({_UNLOADING_SOURCE})", "--"),
+        ]
+    return []
+
+
+# (file stem, title, variables, panels): "one" panel, one per "component", per "car" or per "variable"
+PLOTS: tuple[tuple[str, str, tuple[str, ...], str], ...] = (
+    ("coupler_force", "Coupler forces (tension positive)", ("coupler_force",), "one"),
+    ("fluid_force", "Force of the liquid on each tank (tank frame)", ("fluid_force_tank",), "component"),
+    ("oil_com", "Liquid centre of mass (tank frame)", ("oil_com_tank",), "component"),
+    ("wheel_loads", "Vertical wheel loads Q", ("wheel_vertical",), "car"),
+    ("wheel_unloading", "Wheel unloading ΔQ/Q₀ = (Q₀ − Q)/Q₀", ("unloading",), "car"),
+    ("l_over_v", "Derailment quotient L/V = |Y|/Q", ("l_over_v",), "car"),
+    ("wheelset_lateral", "Wheelset lateral displacement from the track centreline", ("wheelset_lateral",), "car"),
+    ("speed", "Speed", ("tank_speed",), "one"),
+    ("slosh_force", "Force of the liquid on the tank (tank frame)", ("force_tank",), "component"),
+    ("slosh_moment", "Moment of the liquid on the tank about its centre (tank frame)", ("moment_tank",), "component"),
+    ("slosh_com", "Liquid centre of mass (tank frame)", ("com_tank",), "component"),
+    ("energy", "Energies of the liquid", ("kinetic_energy", "potential_energy"), "variable"),
 )
 
 
-def _label(da: Any, index: dict[str, Any]) -> str:
-    parts = [f"{d} {v}" for d, v in index.items()]
-    return ", ".join(parts) if parts else str(da.name)
+def _cars(ds: Any) -> int:
+    if "car" in ds.sizes:
+        return int(ds.sizes["car"])
+    n = int(ds.sizes.get("wheelset", 0))
+    return n // 4 if n >= 4 and n % 4 == 0 else 1
 
 
-def _lines(ax: Any, da: Any) -> int:
-    """Draws every time series of ``da`` (dims ``time`` + others) on ``ax``; returns the count."""
+def _series(da: Any, per_car: int) -> Iterator[tuple[str, Any, dict[str, Any]]]:
+    """``(legend label, 1-D series, line style)`` of every line of ``da`` (dims time + others)."""
+    from matplotlib.colors import to_hex
+
     other = [d for d in da.dims if d != "time"]
-    t = da["time"].values
-    n = 0
     if not other:
-        ax.plot(t, da.values, label=str(da.name))
-        return 1
-    stacked = da.stack(series=other) if len(other) > 1 else da.rename({other[0]: "series"})
+        yield label(str(da.name)), da, {}
+        return
+    stacked = da.stack(series=other)
     for k in range(stacked.sizes["series"]):
         s = stacked.isel(series=k)
-        index = {d: s[d].values.item() for d in other} if len(other) > 1 else {other[0]: s["series"].values.item()}
-        ax.plot(t, s.values, label=_label(da, index), lw=1.2)
-        n += 1
-    return n
+        c = {d: s[d].values.item() for d in other}
+        style: dict[str, Any] = {}
+        if "wheelset" in c:
+            ws = int(c["wheelset"])
+            car = (ws - 1) // per_car + 1 if per_car else 1
+            text = f"car {car}, wheelset {ws}"
+            # resolved now, inside the style context: "CN" would be looked up again when saved
+            style["color"] = to_hex(f"C{(ws - 1) % per_car if per_car else 0}")
+            if "side" in c:
+                text += f", {c['side']}"
+                style["ls"] = "-" if c["side"] == "left" else "--"
+        elif "car" in c and len(c) == 1:
+            text = f"car {c['car']}"
+            style["ls"] = ("-", "--", "-.", ":")[(int(c["car"]) - 1) % 4]  # identical cars stay visible
+        elif "coupler" in c:
+            text = f"coupler {c['coupler']} (cars {c['coupler']}–{int(c['coupler']) + 1})"
+        else:
+            text = ", ".join(f"{d} {v}" for d, v in c.items())
+        yield text, s, style
+
+
+def _panels(ds: Any, spec: tuple[str, str, tuple[str, ...], str]) -> list[tuple[str, Any]]:
+    """``(y label, DataArray)`` of each panel; the DataArrays are in SI units."""
+    _, _, names, kind = spec
+    present = [n for n in names if n in ds.data_vars and ds[n].size]
+    if kind == "variable":
+        return [(LABELS.get(n, (n, n, ""))[1], ds[n]) for n in present]
+    da = ds[present[0]]
+    name = present[0]
+    long, short, _ = LABELS.get(name, (name, name, ""))
+    if kind == "component" and "component" in da.dims:
+        words = _ROTATIONS if LABELS.get(name, ("", "", ""))[2] == "moment" else _AXES
+        return [(f"{words.get(str(c), str(c))} {short}", da.sel(component=c)) for c in da["component"].values]
+    if kind == "car" and "wheelset" in da.dims and da.sizes["wheelset"] % _cars(ds) == 0:
+        per = da.sizes["wheelset"] // _cars(ds)
+        return [(short, da.isel(wheelset=slice(k * per, (k + 1) * per))) for k in range(_cars(ds))]
+    return [(long, da)]
+
+
+def _shade_settling(ax: Any, ts: float, first: bool) -> None:
+    if ts <= 0:
+        return
+    ax.axvspan(0.0, ts, color="0.88", zorder=0, lw=0)
+    if first:
+        ax.annotate(
+            f"settling\n(t < {ts:.3g} s)",
+            (ts, 1.0),
+            xycoords=("data", "axes fraction"),
+            xytext=(3, -3),
+            textcoords="offset points",
+            va="top",
+            fontsize=7,
+            color="0.35",
+            bbox={"fc": "white", "ec": "none", "alpha": 0.75, "pad": 1.0},
+        )
+
+
+def _focus(ax: Any, t: np.ndarray, ys: Sequence[np.ndarray], ts: float, refs: Sequence[float], unit: str) -> None:
+    """Y range from the data after settling and the reference lines; settling-phase values
+    beyond it are clipped, and the clip is said in the panel."""
+    after = t >= ts
+    if ts <= 0 or after.sum() < 2:
+        return
+    post = np.concatenate([y[after] for y in ys])
+    pre = np.concatenate([y[~after] for y in ys])
+    post, pre = post[np.isfinite(post)], pre[np.isfinite(pre)]
+    if post.size == 0 or pre.size == 0:
+        return
+    lo, hi = min([post.min(), *refs]), max([post.max(), *refs])
+    pad = 0.08 * (hi - lo) if hi > lo else max(abs(hi), 1e-12) * 0.05
+    if pre.min() >= lo - pad and pre.max() <= hi + pad:
+        return
+    ax.set_ylim(lo - pad, hi + pad)
+    ax.annotate(
+        f"settling phase clipped: {pre.min():.4g} to {pre.max():.4g}{f' {unit}' if unit else ''}",
+        (0.0, 0.02),
+        xycoords="axes fraction",
+        xytext=(3, 0),
+        textcoords="offset points",
+        fontsize=7,
+        color="0.35",
+    )
+
+
+def _min_span(ax: Any, span: float) -> None:
+    """At least ``span`` of y range, so round-off noise of a series that stays near a constant
+    (the lateral load in straight braking) is drawn flat, not as a signal."""
+    lo, hi = ax.get_ylim()
+    if span > 0 and hi - lo < span:
+        mid = 0.5 * (lo + hi)
+        ax.set_ylim(mid - 0.5 * span, mid + 0.5 * span)
+
+
+def _draw(fig: Any, ds: Any, spec: tuple[str, str, tuple[str, ...], str]) -> None:
+    from railslosh import results
+
+    stem, title, names, kind = spec
+    panels = _panels(ds, spec)
+    ts = results.settling(ds).time
+    t = np.asarray(ds["time"].values, dtype=float)
+    values = np.concatenate([np.ravel(ds[n].values) for n in names if n in ds.data_vars])
+    per_car = ds.sizes.get("wheelset", 0) // _cars(ds) if "wheelset" in ds.sizes else 0
+    axes = fig.subplots(len(panels), 1, sharex=True, squeeze=False)[:, 0]
+    for k, (ax, (ylabel, da)) in enumerate(zip(axes, panels, strict=True)):
+        name = str(da.name)
+        unit, f = display_unit(name, da.values if kind == "variable" else values, da.attrs.get("units", ""))
+        ys = []
+        for text, s, style in _series(da.transpose("time", ...), per_car):
+            y = np.asarray(s.values, dtype=float) * f
+            ax.plot(t, y, label=text, **style)
+            ys.append(y)
+        refs = []
+        for value, text, ls in limits(ds, name):
+            ax.axhline(value * f, color="k", ls=ls, lw=1.0, label=text)
+            refs.append(value * f)
+        _shade_settling(ax, ts, k == 0)
+        _focus(ax, t, ys, ts, refs, unit)
+        floor = max(
+            0.02 * float(np.nanmax(np.abs(values), initial=0.0)),
+            _RESOLUTION.get(LABELS.get(name, ("", "", ""))[2], 0.0),
+        )
+        _min_span(ax, floor * f)
+        ax.set_ylabel(_with_unit(ylabel, unit))
+        if kind == "car" and len(panels) > 1:
+            ax.set_title(f"car {k + 1}", loc="left")
+        if len(ax.get_lines()) > 1:
+            ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    axes[-1].set_xlabel("Time (s)")
+    frame = ds[names[0]].attrs.get("frame", "") if names[0] in ds.data_vars else ""
+    run = ds.attrs.get("title", "")
+    fig.suptitle(f"{title}{f' — {run}' if run else ''}")
+    if frame:
+        fig.text(0.995, 0.005, f"frame: {frame} (docs/frames.md)", ha="right", va="bottom", fontsize=7, color="0.4")
+
+
+def figure(ds: Any, stem: str) -> Any:
+    """The :class:`matplotlib.figure.Figure` of plot ``stem`` (:data:`PLOTS`), drawn in
+    :data:`STYLE`, or ``None`` when the Dataset lacks its variables or has fewer than 2 samples."""
+    import matplotlib.style
+    from matplotlib.figure import Figure
+
+    spec = next((p for p in PLOTS if p[0] == stem), None)
+    if spec is None:
+        raise ValueError(f"invalid parameter `stem` = {stem!r}: expected one of {', '.join(p[0] for p in PLOTS)}")
+    if not any(n in ds.data_vars and ds[n].size for n in spec[2]) or ds.sizes.get("time", 0) < 2:
+        return None
+    with matplotlib.style.context(STYLE):
+        n = len(_panels(ds, spec))
+        fig = Figure(figsize=(9.0, 1.2 + 1.9 * n if n > 1 else 4.2))
+        _draw(fig, ds, spec)
+    return fig
 
 
 def plot_dataset(ds: Any, out_dir: str | os.PathLike[str], *, dpi: int = 100) -> list[Path]:
     """Writes one PNG per plot of :data:`PLOTS` whose variables are in ``ds``; returns the paths."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    import matplotlib.style
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    title = ds.attrs.get("title", "")
     paths = []
-    for stem, what, names in PLOTS:
-        present = [n for n in names if n in ds.data_vars]
-        if not present or ds.sizes.get("time", 0) < 2:
-            continue
-        fig, ax = plt.subplots(figsize=(8, 4.5))
-        n = 0
-        for name in present:
-            n += _lines(ax, ds[name])
-        units = {ds[n].attrs.get("units", "") for n in present}
-        frame = ds[present[0]].attrs.get("frame", "")
-        ax.set_xlabel("time (s)")
-        ax.set_ylabel(f"{', '.join(present)} ({'/'.join(sorted(units))})")
-        ax.set_title(f"{what}{f' - {title}' if title else ''}", fontsize=10)
-        ax.grid(True, alpha=0.3)
-        if 1 < n <= 12:
-            ax.legend(fontsize=7, ncol=2 if n > 6 else 1)
-        if frame:
-            ax.annotate(f"frame: {frame}", (0.99, 0.01), xycoords="axes fraction", ha="right", fontsize=7)
-        fig.tight_layout()
-        p = out / f"{stem}.png"
-        fig.savefig(p, dpi=dpi)
-        plt.close(fig)
-        paths.append(p)
+    with matplotlib.style.context(STYLE):
+        for spec in PLOTS:
+            fig = figure(ds, spec[0])
+            if fig is None:
+                continue
+            p = out / f"{spec[0]}.png"
+            fig.savefig(p, dpi=dpi)
+            paths.append(p)
     return paths
 
 
-def peak_table(ds: Any) -> list[tuple[str, str, float, float]]:
-    """``(variable, units, max |value|, time of the max)`` of every variable, for reports."""
-    rows = []
-    for name, da in ds.data_vars.items():
-        v = np.abs(np.asarray(da.values, dtype=float))
-        if v.size == 0 or not np.isfinite(v).any():
-            continue
-        flat = np.nanargmax(v)
-        it = np.unravel_index(flat, v.shape)[0]
-        rows.append((str(name), da.attrs.get("units", ""), float(v.flat[flat]), float(ds["time"].values[it])))
-    return rows
+def peak_table(ds: Any, *, include_settling: bool = False) -> list[tuple[str, str, float, float]]:
+    """``(variable, units, max |value|, time of the max)`` of every variable, after the settling
+    phase unless ``include_settling`` (:func:`railslosh.results.peaks`, largest over components)."""
+    from railslosh import results
+
+    best: dict[str, tuple[str, str, float, float]] = {}
+    for p in results.peaks(ds, include_settling=include_settling):
+        if p.name not in best or abs(p.value) > best[p.name][2]:
+            best[p.name] = (p.name, p.units, abs(p.value), p.time)
+    return list(best.values())

@@ -1,6 +1,9 @@
-"""A self-contained HTML report of a results directory (``railslosh report DIR``): the scene, the
-solver statistics, a table of peak values and every plot, with the PNGs embedded as data URIs
-(the page can be mailed or archived alone).
+"""A self-contained HTML report of a results directory (``railslosh report DIR``), rendered from the
+jinja2 template ``templates/report.html.j2``: the settling phase and how it was found, a summary
+table of the headline results after settling (with the standard limits and the values the
+settling phase would have given), the run's invariant margins, a figure gallery (PNGs embedded as
+data URIs, so the page can be mailed or archived alone), the solver statistics and the scene, all
+in engineering units rounded to meaningful digits.
 
     >>> from railslosh import report
     >>> report.write_report("out/ecp_light")        # -> out/ecp_light/report.html
@@ -9,32 +12,371 @@ solver statistics, a table of peak values and every plot, with the PNGs embedded
 from __future__ import annotations
 
 import base64
-import html
 import json
+import math
 import os
 from pathlib import Path
+from typing import Any
 
-__all__ = ["write_report"]
+import numpy as np
 
-_CSS = """
-body { font-family: system-ui, sans-serif; margin: 2em auto; max-width: 1100px; color: #222; }
-h1 { font-size: 1.6em; margin-bottom: 0.2em; } h2 { font-size: 1.2em; border-bottom: 1px solid #ccc; }
-table { border-collapse: collapse; font-size: 0.9em; } td, th { border: 1px solid #ddd; padding: 3px 8px; }
-th { background: #f0f3f7; text-align: left; } td.num { text-align: right; font-family: monospace; }
-figure { display: inline-block; margin: 0.5em; } img { max-width: 520px; border: 1px solid #ddd; }
-pre { background: #f6f8fa; padding: 0.8em; overflow-x: auto; font-size: 0.8em; }
-.meta { color: #555; }
-"""
+__all__ = ["HEADLINE", "num", "write_report"]
+
+TEMPLATE = Path(__file__).with_name("templates") / "report.html.j2"
+"""The jinja2 template of the report."""
+
+HEADLINE: tuple[tuple[str, str], ...] = (
+    ("coupler_force", "max"),
+    ("coupler_force", "min"),
+    ("fluid_force_tank", "abs"),
+    ("force_tank", "abs"),
+    ("moment_tank", "abs"),
+    ("wheel_vertical", "max"),
+    ("wheel_vertical", "min"),
+    ("unloading", "max"),
+    ("l_over_v", "max"),
+    ("wheel_lateral", "abs"),
+    ("wheelset_lateral", "abs"),
+    ("slosh_displacement", "abs"),
+)
+"""Rows of the summary table: ``(variable, extreme)`` with extreme ``"abs"`` (largest ``|value|``),
+``"max"`` or ``"min"``; one row per component for vectors."""
+
+_MODE = {"abs": "", "max": ", largest", "min": ", smallest"}
+# (variable, extreme) -> (index in plots.limits, the value must stay "below" / "above" it)
+_LIMITS = {
+    ("l_over_v", "max"): (0, "below"),
+    ("unloading", "max"): (0, "below"),
+    ("wheel_vertical", "min"): (1, "above"),
+}
 
 
-def _img(path: Path) -> str:
-    data = base64.b64encode(path.read_bytes()).decode("ascii")
-    return f'<figure><img alt="{html.escape(path.stem)}" src="data:image/png;base64,{data}"></figure>'
+def num(v: Any, sig: int = 4, *, strip: bool = False) -> str:
+    """``v`` to ``sig`` significant digits (whole digits are kept), thin-space thousands; ``—``
+    for missing or non-finite values; scientific notation below 1e-3 and from 1e7. ``strip``
+    drops trailing zeros (inputs such as scene parameters, whose digits are exact)."""
+    try:
+        x = float(v)
+    except (TypeError, ValueError):
+        return "—"
+    if not math.isfinite(x):
+        return "—"
+    if x == 0:
+        return "0"
+    mag = math.floor(math.log10(abs(x)))
+    if mag < -3 or mag >= 7:
+        text = f"{x:.{sig - 1}e}"
+        if strip:
+            mant, exp = text.split("e")
+            text = f"{mant.rstrip('0').rstrip('.')}e{exp}"
+        return text
+    text = f"{x:,.{max(0, sig - 1 - mag)}f}"
+    if strip and "." in text:
+        text = text.rstrip("0").rstrip(".")
+    return text.replace(",", "\u2009")
+
+
+def _where(p: Any, per_car: int) -> str:
+    w = p.where
+    if "wheelset" in w:
+        ws = int(w["wheelset"])
+        car = f"car {(ws - 1) // per_car + 1}, " if per_car else ""
+        return f"{car}wheelset {ws}" + (f", {w['side']}" if "side" in w else "")
+    if "coupler" in w:
+        k = int(w["coupler"])
+        return f"coupler {k} (cars {k}–{k + 1})"
+    return ", ".join(f"{d} {v}" for d, v in w.items())
+
+
+def _quantity(name: str, comp: str | None, mode: str) -> str:
+    from railslosh import plots
+
+    text = plots.label(name) + (" (tension +)" if name == "coupler_force" else "")
+    if comp is not None:
+        words = plots._ROTATIONS if plots.LABELS.get(name, ("", "", ""))[2] == "moment" else plots._AXES
+        text += f", {words.get(comp, comp).lower()} ({comp})"
+    return text + _MODE[mode]
+
+
+def _summary(ds: Any, ts: float) -> list[dict[str, Any]]:
+    from railslosh import plots, results
+
+    per_car = ds.sizes["wheelset"] // plots._cars(ds) if "wheelset" in ds.sizes else 0
+    rows = []
+    for name, mode in HEADLINE:
+        if name not in ds.data_vars or "time" not in ds[name].dims or not ds[name].size:
+            continue
+        unit, f = plots.display_unit(name, ds[name].values, ds[name].attrs.get("units", ""))
+        for comp, da in results._split(ds[name]):
+            p = results.extreme(da, mode=mode, after=ts)
+            if p is None:
+                continue
+            before = (
+                results.extreme(da.isel(time=np.flatnonzero(da["time"].values < ts)), mode=mode) if ts > 0 else None
+            )
+            limit, limit_class = "", ""
+            if (name, mode) in _LIMITS:
+                idx, side = _LIMITS[name, mode]
+                lims = plots.limits(ds, name)
+                if idx < len(lims):
+                    value, text, _ = lims[idx]
+                    ok = p.value <= value if side == "below" else p.value >= value
+                    # "limit 0.8 (UIC 518, EN 14363)" -> "UIC 518, EN 14363"; wheel loads: "ΔQ/Q₀ = 0.6; UIC ..."
+                    if name == "wheel_vertical":
+                        source = text.replace(" (", "; ", 1).removesuffix(")")
+                    else:
+                        source = text[text.find("(") + 1 : text.rfind(")")]
+                    bound = (
+                        f"{'≤' if side == 'below' else '≥'} {num(value * f, 3, strip=True)}{f' {unit}' if unit else ''}"
+                    )
+                    limit = f"{bound} ({source})"
+                    limit_class = "ok" if ok else "bad"
+            rows.append(
+                {
+                    "name": name,
+                    "component": comp or "",
+                    "mode": mode,
+                    "si": repr(p.value),
+                    "quantity": _quantity(name, comp, mode),
+                    "where": _where(p, per_car) or "tank",
+                    "value": num(p.value * f),
+                    "unit": unit,
+                    "time": num(p.time, 4),
+                    "limit": limit,
+                    "limit_class": limit_class,
+                    "settling": "—" if before is None else f"{num(before.value * f)} at {num(before.time, 3)} s",
+                }
+            )
+    return rows
+
+
+def _statistics(ds: Any) -> list[dict[str, Any]]:
+    from railslosh import plots, results
+
+    rows = []
+    for s in results.statistics(ds):
+        unit, f = plots.display_unit(s.name, ds[s.name].values, s.units)
+        quantity = _quantity(s.name, s.component, "abs")
+        rows.append(
+            {
+                "quantity": quantity,
+                "min": num(s.min * f),
+                "max": num(s.max * f),
+                "mean": num(s.mean * f),
+                "unit": unit,
+                "variable": s.name + (f"[{s.component}]" if s.component else ""),
+            }
+        )
+    return rows
+
+
+# Defaults of rail_mbs::invariants (MIN_VOLUME_RATIO, ENERGY_GROWTH_LIMIT); runs use these.
+_MIN_VOLUME_RATIO = 0.1
+_ENERGY_GROWTH_LIMIT = 0.05
+
+
+def _margins(a: dict[str, Any]) -> list[dict[str, str]]:
+    rows = []
+
+    def row(what: str, value: str, time: Any, limit: str, ok: bool | None, share: str = "") -> None:
+        status = "" if ok is None else ("ok" if ok else "exceeded") + share
+        cls = "" if ok is None else ("ok" if ok else "bad")
+        rows.append(
+            {"what": what, "value": value, "time": num(time, 4), "limit": limit, "status": status, "status_class": cls}
+        )
+
+    if "margin_worst_gap" in a:
+        gap, lim = float(a["margin_worst_gap"]), float(a.get("margin_gap_limit", math.nan))
+        share = f" ({num(100 * gap / lim, 2, strip=True)} % of the limit)" if lim > 0 else ""
+        row(
+            "Containment: largest gap of the liquid beyond a wall",
+            f"{num(gap * 1e3, 3)} mm",
+            a.get("margin_worst_gap_time"),
+            f"{num(lim * 1e3, 3)} mm (half the smallest element edge)",
+            gap <= lim if math.isfinite(lim) else None,
+            share,
+        )
+    if "margin_min_volume_ratio" in a:
+        j = float(a["margin_min_volume_ratio"])
+        lim_text = f"> {_MIN_VOLUME_RATIO:g} (distorted below, inverted at 0)"
+        row(
+            "Element validity: smallest volume ratio J = det F",
+            num(j, 4),
+            a.get("margin_min_volume_ratio_time"),
+            lim_text,
+            j > _MIN_VOLUME_RATIO,
+        )
+    if "margin_worst_energy_error" in a:
+        eps = float(a["margin_worst_energy_error"])
+        lim_text = f"≤ {_ENERGY_GROWTH_LIMIT:g} (≤ 0 when physical)"
+        row(
+            "Energy balance: largest energy growth ε",
+            num(eps, 2),
+            a.get("margin_worst_energy_time"),
+            lim_text,
+            eps <= _ENERGY_GROWTH_LIMIT,
+        )
+    if "margin_dissipated" in a:
+        e = float(a["margin_dissipated"])
+        value = f"{num(e / 1e3, 4)} kJ" if abs(e) >= 1e4 else f"{num(e, 4)} J"
+        row("Energy dissipated by the liquid (damping, viscosity)", value, None, "—", None)
+    return rows
+
+
+_STATS = {
+    "steps": "time steps",
+    "rejected_steps": "rejected steps",
+    "newton_iterations": "Newton iterations",
+    "factorizations": "LU factorizations",
+    "jacobian_evaluations": "Jacobian evaluations",
+    "wall_time": "solver wall time (s)",
+    "time_total": "solver wall time (s)",
+    "time_assembly": "  of which assembly (s)",
+    "time_factorization": "  of which factorization (s)",
+    "time_solve": "  of which linear solves (s)",
+}
+
+
+def _solver(ds: Any) -> list[tuple[str, str]]:
+    a = ds.attrs
+    t = np.asarray(ds["time"].values, dtype=float)
+    rows = [("simulated time (s)", num(t[-1] if t.size else 0.0, 4)), ("recorded samples", str(t.size))]
+    for k, v in a.items():
+        if k.startswith("stats_"):
+            key = k[6:]
+            rows.append((_STATS.get(key, key.replace("_", " ")), num(v, 3) if "time" in key else str(v)))
+    if "stats_newton_iterations" in a and a.get("stats_steps"):
+        rows.append(
+            ("Newton iterations per step", num(float(a["stats_newton_iterations"]) / float(a["stats_steps"]), 3))
+        )
+    if "dof" in a:
+        rows.append(("degrees of freedom", str(a["dof"])))
+    if "elements" in a:
+        rows.append(("fluid elements per tank", str(a["elements"])))
+    if "fluid_mass" in a:
+        rows.append(("liquid mass per tank (t)", num(float(a["fluid_mass"]) / 1e3, 4)))
+    if "static_wheel_load" in a:
+        rows.append(("static wheel load Q₀ (kN)", num(float(a["static_wheel_load"]) / 1e3, 4)))
+    if "wall_damping_ratio" in a:
+        rows.append(("wall damping ratio", num(a["wall_damping_ratio"], 3, strip=True)))
+    for k, why, text in (
+        ("fluid_model", "fluid_model_reason", "liquid model"),
+        ("stepper", "stepper_reason", "stepper"),
+        ("load_filter", "", "load recording"),
+    ):
+        if k in a:
+            rows.append((text, f"{a[k]}" + (f" ({a[why]})" if why and a.get(why) else "")))
+    return rows
+
+
+# scene key -> (unit shown, factor from the scene's value); the scene dict is in SI units
+_SCENE_UNITS: dict[str, tuple[str, float]] = {
+    "speed": ("km/h", 3.6),
+    "speed_kmh": ("km/h", 1.0),
+    "design_v1_kmh": ("km/h", 1.0),
+    "speed_mph": ("mph", 1.0),
+    "station": ("m", 1.0),
+    "length": ("m", 1.0),
+    "offset": ("m", 1.0),
+    "hold": ("m", 1.0),
+    "height": ("m", 1.0),
+    "height_in": ("in", 1.0),
+    "wheelset_lateral_offset": ("mm", 1e3),
+    "t_end": ("s", 1.0),
+    "t0": ("s", 1.0),
+    "settle_time": ("s", 1.0),
+    "design_duration": ("s", 1.0),
+    "snapshot_every": ("s", 1.0),
+    "record_every": ("s", 1.0),
+    "step": ("ms", 1e3),
+    "times": ("s", 1.0),
+    "mass": ("t", 1e-3),
+    "torques": ("kN m", 1e-3),
+    "fill": ("%", 100.0),
+    "suspension_frequency": ("Hz", 1.0),
+    "coupler_stiffness": ("MN/m", 1e-6),
+    "coupler_damping": ("kN s/m", 1e-3),
+}
+
+
+_SCENE_NAMES = {"speed_kmh": "speed", "speed_mph": "speed", "design_v1_kmh": "design end speed", "t0": "start time"}
+
+
+def _scene_value(key: str, v: Any) -> str:
+    unit, f = _SCENE_UNITS.get(key, ("", 1.0))
+    if isinstance(v, bool):
+        return "yes" if v else "no"
+    if isinstance(v, int | float):
+        return f"{num(v * f, strip=True)}{f' {unit}' if unit else ''}"
+    if isinstance(v, list | tuple) and v and all(isinstance(x, int | float) and not isinstance(x, bool) for x in v):
+        if key == "counts":
+            return " × ".join(str(x) for x in v)
+        return ", ".join(num(x * f, strip=True) for x in v) + (f" {unit}" if unit else "")
+    if isinstance(v, dict):
+        return "; ".join(f"{k} = {_scene_value(k, x)}" for k, x in v.items())
+    return str(v)
+
+
+def _track(rows: list[list[float]]) -> dict[str, Any]:
+    """The track table in words: curve radius and side, superelevation in mm, grade in ‰, rail cant 1:n."""
+    header = ["from s (m)", "curve", "superelevation (mm)", "grade (‰)", "rail cant right", "rail cant left"]
+    out = []
+    for r in rows:
+        r = [float(x) for x in r] + [0.0] * (6 - len(r))
+        k = r[1]
+        curve = (
+            "tangent" if abs(k) < 1e-12 else f"R = {num(1 / abs(k), 4, strip=True)} m {'left' if k > 0 else 'right'}"
+        )
+        cant = ["0" if abs(c) < 1e-12 else f"1:{num(1 / math.tan(abs(c)), 3, strip=True)}" for c in r[4:6]]
+        out.append(
+            [num(r[0], 6, strip=True), curve, num(r[2] * 1e3, 3, strip=True), num(r[3] * 1e3, 3, strip=True), *cant]
+        )
+    return {"header": header, "rows": out}
+
+
+def _scene(ds: Any) -> tuple[list[tuple[str, list[tuple[str, str]]]], dict[str, Any] | None]:
+    try:
+        d = json.loads(ds.attrs.get("scene_json", ""))
+    except ValueError:
+        return [], None
+    if not isinstance(d, dict):
+        return [], None
+    sections, track = [], None
+    for section, body in d.items():
+        if section == "scene" or not isinstance(body, dict):
+            continue
+        rows = []
+        for k, v in body.items():
+            if section == "track" and k == "rows" and isinstance(v, list):
+                track = _track(v)
+                continue
+            key = _SCENE_NAMES.get(k, k.replace("_", " "))
+            rows.append((key, _scene_value(k, v)))
+        if rows:
+            sections.append((section, rows))
+    return sections, track
+
+
+def _figures(pngs: list[Path]) -> list[dict[str, str]]:
+    from railslosh import plots
+
+    order = {p[0]: (i, p[1]) for i, p in enumerate(plots.PLOTS)}
+    pngs = sorted(pngs, key=lambda p: (order.get(p.stem, (len(order), ""))[0], p.stem))
+    return [
+        {
+            "caption": order.get(p.stem, (0, p.stem.replace("_", " ")))[1],
+            "data": base64.b64encode(p.read_bytes()).decode("ascii"),
+        }
+        for p in pngs
+    ]
 
 
 def write_report(results_dir: str | os.PathLike[str], out: str | os.PathLike[str] | None = None) -> Path:
     """Writes ``report.html`` for a directory made by ``railslosh run`` (``results.nc`` and
-    ``plots/*.png``; plots are drawn first when missing). Returns the HTML path."""
+    ``plots/*.png``; plots are drawn first when missing). Returns the HTML path. A directory
+    without ``results.nc``, or a ``results.nc`` that is not netCDF, raises :class:`ValueError`."""
+    import jinja2
+
     from railslosh import plots, results
 
     d = Path(results_dir)
@@ -45,48 +387,43 @@ def write_report(results_dir: str | os.PathLike[str], out: str | os.PathLike[str
     pngs = sorted((d / "plots").glob("*.png"))
     if not pngs:
         pngs = plots.plot_dataset(ds, d / "plots")
-    title = ds.attrs.get("title") or d.name
-    stats = {k[6:]: v for k, v in ds.attrs.items() if k.startswith("stats_")}
-    parts = [
-        "<!DOCTYPE html>",
-        '<html lang="en"><head><meta charset="utf-8">',
-        f"<title>railslosh report - {html.escape(str(title))}</title><style>{_CSS}</style></head><body>",
-        f"<h1>{html.escape(str(title))}</h1>",
-        f'<p class="meta">{html.escape(str(ds.attrs.get("scene_description", "")))} &middot; '
-        f"{html.escape(str(ds.attrs.get('source', '')))} &middot; {html.escape(str(ds.attrs.get('history', '')))} "
-        f"&middot; simulated {float(ds['time'].values[-1]):.3f} s</p>",
-    ]
-    if "error" in ds.attrs:
-        parts.append(f"<p><b>The run stopped early:</b> {html.escape(str(ds.attrs['error']))}</p>")
-    parts.append("<h2>Solver</h2><table><tr><th>statistic</th><th>value</th></tr>")
-    for k, v in stats.items():
-        parts.append(f'<tr><td>{html.escape(k)}</td><td class="num">{html.escape(str(v))}</td></tr>')
-    for k in ("dof", "static_wheel_load", "fluid_mass", "elements"):
-        if k in ds.attrs:
-            parts.append(f'<tr><td>{k}</td><td class="num">{ds.attrs[k]}</td></tr>')
-    parts.append("</table><h2>Peak values</h2><table><tr><th>variable</th><th>max |value|</th><th>units</th>")
-    parts.append("<th>at t (s)</th><th>frame</th></tr>")
-    for name, units, peak, t in plots.peak_table(ds):
-        frame = ds[name].attrs.get("frame", "")
-        parts.append(
-            f'<tr><td>{html.escape(name)}</td><td class="num">{peak:.6g}</td><td>{html.escape(units)}</td>'
-            f'<td class="num">{t:.3f}</td><td>{html.escape(frame)}</td></tr>'
-        )
-    parts.append("</table><h2>Figures</h2>")
-    parts.extend(_img(p) for p in pngs)
-    pvd = sorted(d.glob("*.pvd"))
-    if pvd:
-        parts.append(
-            f"<p>Fluid snapshots for ParaView: <code>{html.escape(pvd[0].name)}</code> (open it in ParaView, "
-            "then play the time series).</p>"
-        )
-    if "scene_json" in ds.attrs:
-        try:
-            scene_txt = json.dumps(json.loads(ds.attrs["scene_json"]), indent=1)
-        except ValueError:
-            scene_txt = str(ds.attrs["scene_json"])
-        parts.append(f"<h2>Scene</h2><pre>{html.escape(scene_txt)}</pre>")
-    parts.append("</body></html>")
+    settle = results.settling(ds)
+    t = np.asarray(ds["time"].values, dtype=float)
+    scene, track = _scene(ds)
+    kinds = {"slosh": "slosh scene", "vehicle": "vehicle scene", "fluid_vehicle": "vehicle scene with liquid"}
+    context = {
+        "title": str(ds.attrs.get("title") or d.name),
+        "description": str(ds.attrs.get("scene_description", "")),
+        "kind": kinds.get(str(ds.attrs.get("scene_kind", "")), str(ds.attrs.get("scene_kind", "")) or "run"),
+        "source": str(ds.attrs.get("source", "railslosh")),
+        "history": str(ds.attrs.get("history", "")),
+        "simulated": f"{num(t[-1], 4, strip=True)} s" if t.size else "nothing",
+        "error": str(ds.attrs.get("error", "")),
+        "settling": {
+            "time": settle.time,
+            "time_text": num(settle.time, 3, strip=True),
+            "rule": settle.rule,
+            "source": settle.source,
+        },
+        "after_text": f"after settling (t ≥ {num(settle.time, 3, strip=True)} s)"
+        if settle.time > 0
+        else "over the whole run",
+        "summary": _summary(ds, settle.time),
+        "statistics": _statistics(ds),
+        "margins": _margins(dict(ds.attrs)),
+        "figures": _figures(pngs),
+        "pvd": next((p.name for p in sorted(d.glob("*.pvd"))), ""),
+        "solver": _solver(ds),
+        "scene": scene,
+        "track": track,
+    }
+    env = jinja2.Environment(
+        loader=jinja2.FileSystemLoader(TEMPLATE.parent),
+        autoescape=True,
+        undefined=jinja2.StrictUndefined,
+        trim_blocks=True,
+        lstrip_blocks=True,
+    )
     path = Path(out) if out is not None else d / "report.html"
-    path.write_text("\n".join(parts), encoding="utf-8")
+    path.write_text(env.get_template(TEMPLATE.name).render(**context), encoding="utf-8")
     return path

@@ -9,6 +9,13 @@ series with a ParaView ``.pvd`` collection.
     ('N', 'positive in tension')
     >>> results.save(ds, "out/results.nc"); ds2 = results.load("out/results.nc")
 
+Every run has a settling phase (:func:`settling`): declared by the ``settle_time`` attribute,
+absent when the run starts from a settled state (``settled_start``), otherwise detected from the
+liquid's vertical load. :func:`peaks` and :func:`statistics` leave it out unless asked::
+
+    >>> results.settling(ds)     # 20 mph lane change: Settling(time=0.0528, source='detected', rule=...)
+    >>> results.peaks(ds)[1]     # Peak(name='force_tank', component='y', value=33.4, time=5.94, ...)
+
 Frames and signs follow ``docs/frames.md``: ``tank`` (K: x forward along the tank axis, y left,
 z up, origin at the tank centre), ``track`` (T(s): tangent, left, up), ``global`` (G: z up).
 Wheel arrays are ordered front to rear over all cars, sides ``[left, right]`` looking forward.
@@ -20,12 +27,31 @@ import datetime as _dt
 import json
 import os
 from collections.abc import Mapping
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-__all__ = ["NETCDF_ENGINE", "VARIABLES", "load", "save", "to_dataset", "write_vtu"]
+__all__ = [
+    "NETCDF_ENGINE",
+    "SETTLING_HOLD",
+    "SETTLING_TOLERANCE",
+    "VARIABLES",
+    "Peak",
+    "Settling",
+    "Statistic",
+    "after_settling",
+    "extreme",
+    "load",
+    "peaks",
+    "save",
+    "settling",
+    "settling_time",
+    "statistics",
+    "to_dataset",
+    "write_vtu",
+]
 
 NETCDF_ENGINE = "netcdf4"
 """Engine of :func:`save` / :func:`load`: the netCDF4 package (its wheels bundle the netCDF-C library);
@@ -99,6 +125,12 @@ def _scene_attrs(sc: Any) -> dict[str, Any]:
     attrs: dict[str, Any] = {"scene_kind": getattr(sc, "kind", ""), "title": getattr(sc, "name", "") or ""}
     if getattr(sc, "description", ""):
         attrs["scene_description"] = sc.description
+    # the declared settling phase (:func:`settling`): a scene's `settle_time` (s), or a start from
+    # a saved rest state (`settled_start`)
+    if getattr(sc, "settle_time", None) is not None:
+        attrs["settle_time"] = float(sc.settle_time)
+    if getattr(sc, "settled_start", False):
+        attrs["settled_start"] = 1
     try:
         attrs["scene_json"] = json.dumps(sc.to_dict(), default=str)
     except (AttributeError, TypeError):
@@ -165,6 +197,10 @@ def to_dataset(res: Mapping[str, Any], scene: Any = None) -> Any:
             attrs[f"margin_{k}"] = v
     if res.get("error"):
         attrs["error"] = str(res["error"])
+    if res.get("settle_time") is not None:
+        attrs["settle_time"] = float(res["settle_time"])
+    if res.get("settled_start"):
+        attrs["settled_start"] = 1
     attrs |= _scene_attrs(scene if scene is not None else res.get("scene"))
     return xr.Dataset(data_vars, coords=coords, attrs=attrs)
 
@@ -178,11 +214,244 @@ def save(ds: Any, path: str | os.PathLike[str]) -> Path:
 
 
 def load(path: str | os.PathLike[str]) -> Any:
-    """Reads a results file written by :func:`save` into memory."""
+    """Reads a results file written by :func:`save` into memory. A missing file raises
+    :class:`FileNotFoundError`, a file that is not netCDF :class:`ValueError`, both naming the path."""
     import xarray as xr
 
-    with xr.open_dataset(path, engine=NETCDF_ENGINE) as ds:
-        return ds.load()
+    p = Path(path)
+    if not p.is_file():
+        what = "a directory" if p.is_dir() else "no such file"
+        raise FileNotFoundError(f"invalid results file `{p}`: {what}; expected a results.nc written by `railslosh run`")
+    try:
+        with xr.open_dataset(p, engine=NETCDF_ENGINE) as ds:
+            return ds.load()
+    except (OSError, ValueError) as exc:  # netCDF4: "[Errno -51] NetCDF: Unknown file format"
+        reason = getattr(exc, "strerror", None) or str(exc).splitlines()[0]
+        raise ValueError(
+            f"invalid results file `{p}`: not a netCDF file ({reason}); "
+            "expected a results.nc written by `railslosh run`"
+        ) from exc
+
+
+# --- the settling phase, peaks and statistics ----------------------------------------------------
+
+SETTLING_TOLERANCE = 0.05
+"""Detected settling ends once the liquid's vertical load stays within this fraction of its settled
+value (the weight) for :data:`SETTLING_HOLD`; the deviation squared measures the energy of the
+start-up oscillation about the rest state, so 5 % leaves 0.25 % of the energy of a release from an
+unloaded start."""
+
+SETTLING_HOLD = 0.1
+"""s: how long the vertical load must stay within :data:`SETTLING_TOLERANCE` (at most a quarter of
+the run)."""
+
+_RULE = "detected: the liquid's vertical load stays within {tol:.0%} of its time average (the weight) for {hold:.3g} s"
+_RULE_DECAY = (
+    "detected: the liquid's vertical load never stays within {tol:.0%} of the weight for {hold:.3g} s before an "
+    "excitation starts; settling ends where its start-up deviation is smallest ({dev:.0%}) before rising again"
+)
+
+
+@dataclass(frozen=True)
+class Settling:
+    """The settling phase ``0 <= t < time`` of a run, and where it came from: ``source`` is
+    ``"declared"`` (the ``settle_time`` attribute: the scene), ``"settled start"`` (the run starts
+    from a saved rest state: ``settled_start`` attribute), ``"detected"`` (:func:`settling`) or
+    ``"none"`` (nothing to detect it from); ``rule`` says it in words."""
+
+    time: float
+    source: str
+    rule: str
+
+
+def _truthy(v: Any) -> bool:
+    if isinstance(v, str):
+        return v.strip().lower() in ("1", "true", "yes")
+    try:
+        return bool(np.asarray(v).item())
+    except (TypeError, ValueError):
+        return False
+
+
+def _vertical_liquid_load(ds: Any) -> np.ndarray | None:
+    """(time, channels) vertical load of the liquid on each tank (tank frame z), or None."""
+    for name in ("fluid_force_tank", "force_tank"):
+        if name in ds.data_vars and "component" in ds[name].dims:
+            da = ds[name].sel(component="z").transpose("time", ...)
+            return np.asarray(da.values, dtype=float).reshape(da.shape[0], -1)
+    return None
+
+
+def _detect(t: np.ndarray, load: np.ndarray) -> tuple[float, str] | None:
+    """End of the start-up transient of the vertical load and the rule that found it (see
+    :func:`settling`), or None."""
+    ok = np.isfinite(load).all(axis=1) & np.isfinite(t)
+    t, load = t[ok], load[ok]
+    if len(t) < 3 or t[-1] <= t[0]:
+        return None
+    span = t[-1] - t[0]
+    weight = np.trapezoid(load, t, axis=0) / span
+    if np.any(np.abs(weight) <= 1e-9 * (np.abs(load).max() + 1e-300)):
+        return None
+    dev = np.max(np.abs(load - weight) / np.abs(weight), axis=1)
+    hold = min(SETTLING_HOLD, span / 4)
+    end = np.searchsorted(t, t + hold * (1 - 1e-9), side="right")
+    n = int(np.searchsorted(t, t[-1] - hold * (1 - 1e-9), side="right"))  # windows that fit the run
+    env = np.array([dev[i : max(end[i], i + 1)].max() for i in range(max(n, 1))])
+    quiet = np.flatnonzero(env <= SETTLING_TOLERANCE)
+    if quiet.size:
+        return float(t[quiet[0]]), _RULE.format(tol=SETTLING_TOLERANCE, hold=hold)
+    # no quiet window (an excitation starts before the liquid has settled that far): the end of
+    # the initial decay, the quietest window before the deviation rises to twice its running minimum
+    low = np.minimum.accumulate(env)
+    rise = np.flatnonzero((env > 2 * low) & (low < env[0]))
+    i = int(np.argmin(env[: rise[0] if rise.size else len(env)]))
+    return float(t[i]), _RULE_DECAY.format(tol=SETTLING_TOLERANCE, hold=hold, dev=env[i])
+
+
+def settling(ds: Any) -> Settling:
+    """The settling phase of a results Dataset, in this order:
+
+    1. the ``settle_time`` attribute (s; the scene's declared settling time), clipped to the run;
+    2. ``settled_start`` true (1, ``"true"``): the run starts from a settled rest state, no settling;
+    3. detected from the liquid's vertical load on each tank (``fluid_force_tank`` / ``force_tank``,
+       tank-frame z): its settled value is its time average over the run (the weight: the liquid
+       starts and ends at rest vertically); settling ends at the first time after which the
+       deviation from it stays within :data:`SETTLING_TOLERANCE` of the weight for
+       :data:`SETTLING_HOLD` s (every tank). Where that never happens because an excitation
+       starts first, it ends where the start-up deviation is quietest before it rises again
+       (to twice its running minimum). A run without a start-up transient gets 0;
+    4. otherwise 0 (``"none"``): runs without liquid start from their static equilibrium (the
+       springs are preloaded); declare ``settle_time`` for other start-up transients (a car set
+       centred into a curve settles onto its flanges in about 0.5 s).
+
+    Deterministic: the same Dataset gives the same time."""
+    t = np.asarray(ds["time"].values, dtype=float)
+    t_end = float(t[-1]) if t.size else 0.0
+    if "settle_time" in ds.attrs:
+        v = float(np.asarray(ds.attrs["settle_time"]).item())
+        if not np.isfinite(v) or v < 0:
+            raise ValueError(f"invalid attribute `settle_time` = {v!r}: expected a time >= 0 s")
+        return Settling(min(v, t_end), "declared", f"declared: the scene's settling time {v:g} s")
+    if _truthy(ds.attrs.get("settled_start", False)):
+        return Settling(0.0, "settled start", "none: the run starts from a settled rest state")
+    load = _vertical_liquid_load(ds)
+    if load is None or not t.size:
+        return Settling(
+            0.0, "none", "none: no liquid load to detect it from; the run starts from its static equilibrium"
+        )
+    found = _detect(t, load)
+    if found is None:
+        return Settling(0.0, "none", "none: too few finite samples of the liquid's vertical load to detect it")
+    return Settling(found[0], "detected", found[1])
+
+
+def settling_time(ds: Any) -> float:
+    """End of the settling phase in s (:func:`settling`)."""
+    return settling(ds).time
+
+
+def after_settling(ds: Any, settle: float | Settling | None = None) -> Any:
+    """The samples at ``t >= settling time`` (:func:`settling`, or the time given)."""
+    if settle is None:
+        settle = settling(ds)
+    ts = settle.time if isinstance(settle, Settling) else float(settle)
+    return ds.isel(time=np.flatnonzero(np.asarray(ds["time"].values) >= ts - 1e-12))
+
+
+@dataclass(frozen=True)
+class Peak:
+    """The largest ``|value|`` of a variable (of one component where it has them): ``value`` is
+    signed, in the variable's ``units``; ``where`` holds the coordinates of the peak (car,
+    wheelset, side, ...); ``after`` is the start of the searched interval (the settling time)."""
+
+    name: str
+    component: str | None
+    value: float
+    time: float
+    where: dict[str, Any]
+    units: str
+    after: float
+
+
+def _split(da: Any) -> list[tuple[str | None, Any]]:
+    if "component" in da.dims:
+        return [(str(c), da.sel(component=c)) for c in da["component"].values]
+    return [(None, da)]
+
+
+def extreme(da: Any, *, mode: str = "abs", after: float = 0.0) -> Peak | None:
+    """The largest ``|value|`` (``mode="abs"``), largest (``"max"``) or smallest (``"min"``) value
+    of a DataArray with a ``time`` dimension over ``t >= after``, as a :class:`Peak`; None when
+    nothing finite is there. A ``component`` coordinate of one component is kept in ``component``."""
+    if mode not in ("abs", "max", "min"):
+        raise ValueError(f"invalid parameter `mode` = {mode!r}: expected 'abs', 'max' or 'min'")
+    da = da.transpose("time", ...)
+    t = np.asarray(da["time"].values, dtype=float)
+    v = np.asarray(da.values, dtype=float)[t >= after - 1e-12]
+    if v.size == 0 or not np.isfinite(v).any():
+        return None
+    key = {"abs": np.abs(v), "max": v, "min": -v}[mode]
+    flat = int(np.nanargmax(key))
+    idx = np.unravel_index(flat, v.shape)
+    where = {}
+    for d, i in zip(da.dims[1:], idx[1:], strict=True):
+        where[d] = da[d].values[i].item() if d in da.coords else int(i)
+    comp = str(da["component"].values.item()) if "component" in da.coords and da["component"].ndim == 0 else None
+    time = float(t[t >= after - 1e-12][idx[0]])
+    return Peak(str(da.name), comp, float(v.flat[flat]), time, where, da.attrs.get("units", ""), float(after))
+
+
+def peaks(ds: Any, *, include_settling: bool = False) -> list[Peak]:
+    """:class:`Peak` (largest ``|value|``) of every variable with a ``time`` dimension, one per
+    component, after the settling phase (:func:`settling`) unless ``include_settling``."""
+    ts = 0.0 if include_settling else settling(ds).time
+    rows = []
+    for da in ds.data_vars.values():
+        if "time" not in da.dims:
+            continue
+        for _, sub in _split(da):
+            p = extreme(sub, after=ts)
+            if p is not None:
+                rows.append(p)
+    return rows
+
+
+@dataclass(frozen=True)
+class Statistic:
+    """Smallest, largest and time-averaged value of a variable (one component where it has them)
+    over ``t >= after``, in its ``units``."""
+
+    name: str
+    component: str | None
+    min: float
+    max: float
+    mean: float
+    units: str
+    after: float
+
+
+def statistics(ds: Any, *, include_settling: bool = False) -> list[Statistic]:
+    """:class:`Statistic` of every variable with a ``time`` dimension (one per component), after
+    the settling phase (:func:`settling`) unless ``include_settling``."""
+    ts = 0.0 if include_settling else settling(ds).time
+    part = after_settling(ds, ts)
+    t = np.asarray(part["time"].values, dtype=float)
+    rows = []
+    for name, da in part.data_vars.items():
+        if "time" not in da.dims:
+            continue
+        for comp, sub in _split(da.transpose("time", ...)):
+            v = np.asarray(sub.values, dtype=float).reshape(len(t), -1)
+            keep = np.isfinite(v).all(axis=1)
+            if v.size == 0 or not keep.any():
+                continue
+            vk, tk = v[keep], t[keep]
+            span = tk[-1] - tk[0]
+            mean = float(np.trapezoid(vk, tk, axis=0).mean() / span) if span > 0 else float(vk.mean())
+            units = da.attrs.get("units", "")
+            rows.append(Statistic(str(name), comp, float(vk.min()), float(vk.max()), mean, units, ts))
+    return rows
 
 
 # --- fluid snapshots for ParaView ----------------------------------------------------------------
