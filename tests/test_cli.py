@@ -98,18 +98,18 @@ def test_run_plot_report_as_a_user_does(tmp_path):
 def test_run_set_overrides_and_errors(tmp_path, capsys):
     scene_file = str(EXAMPLES / "two_car_ecp_braking_rigid.toml")
     r = run_cli("run", scene_file, "-o", str(tmp_path), "--set", "train.speed_kmh=500", "-q")
-    assert r.returncode == 2 and "invalid parameter `train.speed_kmh` = 500" in r.stderr
+    assert r.returncode == 2 and "invalid `train.speed_kmh` = 500: expected a speed" in r.stderr
 
     def status(*args):
         code = cli.main(list(args))
         return code, capsys.readouterr().err
 
     code, err = status("run", scene_file, "--set", "speed=5")
-    assert code == 2 and "invalid parameter `--set`" in err
+    assert code == 2 and "invalid `--set`" in err
     code, err = status("run", str(tmp_path / "missing.toml"))
     assert code == 2 and "missing.toml" in err
     code, err = status("plot", str(tmp_path / "none.nc"))
-    assert code == 2 and "invalid parameter `results`" in err
+    assert code == 2 and "invalid `results`" in err
 
 
 def test_progress_bar_line_shows_time_eta_and_newton_statistics():
@@ -144,3 +144,89 @@ def test_sweep_command_writes_one_dataset(tmp_path):
 
     ds = results.load(tmp_path / "sweep.nc")
     assert ds.sizes["braking"] == 2 and "2/2 runs done" in r.stderr
+
+
+# --- every user mistake is one line on stderr, in one form, exit 2, no traceback (issue 19) --------
+
+SWRI = str(EXAMPLES / "swri_lane_change_20mph.toml")
+RIGID = str(EXAMPLES / "two_car_ecp_braking_rigid.toml")
+
+
+@pytest.fixture(scope="module")
+def mistakes(tmp_path_factory):
+    """Files a user gets wrong: a scene with a misspelled section, an empty scene, a 'results.nc'
+    that is not netCDF, a results directory holding one."""
+    d = tmp_path_factory.mktemp("mistakes")
+    (d / "typo.toml").write_text('[solver]\nt_end = 1.0\n[manuever]\ntype = "pulse"\n')
+    (d / "empty.toml").write_text("# nothing here\n")
+    (d / "some.toml").write_text('[track]\npreset = "tangent"\n')
+    (d / "results.nc").write_text("not netCDF\n")
+    (d / "run").mkdir()
+    (d / "run" / "results.nc").write_text("not netCDF either\n")
+    return d
+
+
+CLI_MISTAKES = [
+    # (arguments, with {d} the mistakes directory; what stderr must say)
+    (["run", "{d}/typo.toml"], "invalid `manuever`: unknown section (did you mean `maneuver`?)"),
+    (
+        ["run", "{d}/empty.toml"],
+        "invalid `scene` = '{d}/empty.toml': expected a vehicle scene ([track], [train], ...) or a slosh scene "
+        "([maneuver], [tank], ...); the file is empty (no sections)",
+    ),
+    (["run", "{d}/missing.toml"], "invalid `scene` = '{d}/missing.toml': no such file"),
+    (["run", "{d}/missing"], "invalid `scene` = '{d}/missing': no such file"),
+    (["run", "{d}/run"], "invalid `scene` = '{d}/run': a directory"),
+    (["run", SWRI, "--set", "solver.t_end=-1"], "invalid `solver.t_end` = -1: expected a time > 0 s and ≤ 600 s"),
+    (["run", SWRI, "--set", "solver.t_end=abc"], "invalid `solver.t_end` = 'abc': expected a time"),
+    (["run", SWRI, "--set", "solver.tend=1"], "invalid `solver.tend`: unknown key (did you mean `solver.t_end`?)"),
+    (["run", SWRI, "--set", "outputs.vtu=true"], "invalid `outputs.vtu` = True: expected false: a slosh scene"),
+    (["run", SWRI, "--set", "fluid.fill=0.99"], "invalid `fluid.fill` = 0.99: expected a volume fraction from 0.03"),
+    (["run", SWRI, "--set", "a.b.c=1"], "invalid `--set` = 'a.b.c': expected a field section.key"),
+    (["run", SWRI, "--set", "solver"], "invalid `--set` = 'solver': expected section.key=VALUE"),
+    (["run", RIGID, "-o", "{d}/some.toml"], "invalid `--out` = '{d}/some.toml': expected a directory"),
+    (["plot", "{d}/results.nc"], "invalid `results` = '{d}/results.nc': expected a results.nc written by"),
+    (["plot", "{d}/some.toml"], "(this is not a netCDF file)"),
+    (["plot", "{d}/none.nc"], "invalid `results` = '{d}/none.nc': no such file"),
+    (["report", "{d}/run"], "invalid `results_dir/results.nc` = '{d}/run/results.nc': expected a results.nc"),
+    (["report", "{d}/nodir"], "invalid `results_dir` = '{d}/nodir': expected a directory written by"),
+    (["sweep", SWRI, "--grid", "fil=0.5,0.6"], "invalid `--grid fil`: unknown grid name (did you mean `fill`?)"),
+    (["sweep", SWRI, "--grid", "fill"], "invalid `--grid` = 'fill': expected NAME=V1,V2,..."),
+    (["sweep", SWRI, "--grid", "fill=0.5,2"], "sweep point {'fill': 2}: invalid `fluid.fill` = 2: expected"),
+    (["sweep", "{d}/missing.toml", "--grid", "fill=0.5"], "invalid `scene` = '{d}/missing.toml': no such file"),
+    (["sweep", SWRI, "--grid", "fill=0.5", "--workers", "0"], "argument --workers: '0': expected a whole number ≥ 1"),
+    (["demo", "--fill", "0.99"], "argument --fill: '0.99': expected a volume fraction from 0.03 to 0.97"),
+    (["validate", "no-such-case"], "invalid `case` = ['no-such-case']: expected"),
+    (["bench", "no-such-sweep"], "invalid `case` = ['no-such-sweep']: expected"),
+]
+
+
+def _id(args):
+    return " ".join(a.rsplit("/", 1)[-1] for a in args)
+
+
+@pytest.mark.parametrize(("args", "says"), CLI_MISTAKES, ids=[_id(a) for a, _ in CLI_MISTAKES])
+def test_a_user_mistake_is_one_line_and_exit_2(mistakes, args, says):
+    r = run_cli(*(a.replace("{d}", str(mistakes)) for a in args))
+    assert r.returncode == 2, r.stderr
+    assert "Traceback" not in r.stderr and says.replace("{d}", str(mistakes)) in r.stderr, r.stderr
+    if not any(a.startswith("--") and "argument" in says for a in args):  # argparse adds its usage line
+        assert len(r.stderr.strip().splitlines()) == 1, r.stderr
+    assert "invalid parameter" not in r.stderr and "allowed" not in r.stderr
+
+
+def test_help_has_examples_and_no_markup():
+    top = run_cli("--help").stdout
+    assert "examples:" in top and "railslosh run examples/scenes/" in top and "``" not in top
+    for command in ("demo", "run", "plot", "report", "sweep", "validate", "bench"):
+        text = run_cli(command, "--help").stdout
+        assert "examples:" in text and f"railslosh {command}" in text, command
+    parser = cli.build_parser()
+    sub = next(a for a in parser._actions if a.dest == "command")
+    for name, p in sub.choices.items():
+        for action in p._actions:
+            assert action.help, f"railslosh {name} {action.option_strings or action.dest} has no help"
+    run = run_cli("run", "--help").stdout
+    sweep = run_cli("sweep", "--help").stdout
+    assert "repeat --set" in " ".join(run.split()) and "repeat --grid" in " ".join(sweep.split())
+    assert "seconds" not in run_cli("bench", "--help").stdout.split("--quick")[1].split("\n")[0]

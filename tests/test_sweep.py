@@ -17,7 +17,7 @@ def test_parse_grid_reads_toml_values():
 
 @pytest.mark.parametrize("bad", ["oil", "=1,2", "oil=", "fill=0.5,0.5"])
 def test_bad_grid_specs_are_value_errors(bad):
-    with pytest.raises(ValueError, match="invalid parameter `--grid"):
+    with pytest.raises(ValueError, match="invalid `--grid"):
         sweep.parse_grid([bad])
 
 
@@ -33,9 +33,9 @@ def test_grid_names_set_the_documented_scene_fields():
     assert over["tank"]["bulkheads"] == [[pytest.approx(-11 / 6), 0.02], [pytest.approx(11 / 6), 0.02]]
     slosh = sweep.grid_overrides({"maneuver": {"speed_mph": 20}}, {"speed": 30})
     assert slosh["maneuver"] == {"speed": None, "speed_mph": None, "speed_kmh": 30}
-    with pytest.raises(ValueError, match="invalid parameter `braking`"):
+    with pytest.raises(ValueError, match="invalid `braking`"):
         sweep.grid_overrides(base, {"braking": "hard"})
-    with pytest.raises(ValueError, match="invalid parameter `bulkheads`"):
+    with pytest.raises(ValueError, match="invalid `bulkheads`"):
         sweep.grid_overrides(base, {"bulkheads": 1.5})
 
 

@@ -16,6 +16,7 @@ MODULES = (
     "railslosh.rail",
     "railslosh.vehicle",
     "railslosh.scene",
+    "railslosh.limits",
     "railslosh.fluid_model",
     "railslosh.results",
     "railslosh.plots",

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 
-from railslosh import _core
+from railslosh import _core, limits
 from railslosh._core import FluidMesh
 
 #: Tank of the crude-oil study (seed 000 §8.1): shell about 12 m long, radius 1.5 m.
@@ -61,13 +61,15 @@ def cylinder_tank(
     head_depth:
         Depth of each half-ellipsoidal head (m); 0 gives flat ends.
     fill:
-        Liquid volume as a fraction of the tank volume, in (0, 0.97].
+        Liquid volume as a fraction of the tank volume, :data:`railslosh.limits.FILL` (0.03 to 0.97,
+        the range scenes accept).
     n_length, n_width, n_height:
         Element counts. The crude-oil paper's meshes are 4x4x2, 6x4x2 and 8x4x2
         (900, 1260 and 1620 coordinates).
     grading:
         Ratio of the front (+x) to the rear (-x) element length (1 = uniform).
     """
+    fill = limits.check("fill", fill)
     return _core.cylinder_tank(length, radius, head_depth, fill, n_length, n_width, n_height, grading)
 
 
@@ -81,5 +83,7 @@ def elliptic_cylinder(
     n_width: int = 6,
     n_height: int = 3,
 ) -> FluidMesh:
-    """Liquid in a flat-ended cylinder of elliptical section (defaults: the SwRI tank of seed 003)."""
+    """Liquid in a flat-ended cylinder of elliptical section (defaults: the SwRI tank of seed 003);
+    ``fill`` as in :func:`cylinder_tank`."""
+    fill = limits.check("fill", fill)
     return _core.elliptic_cylinder(length, semi_axis_y, semi_axis_z, fill, n_length, n_width, n_height)

@@ -19,7 +19,7 @@ import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from railslosh import _core
+from railslosh import _core, limits
 from railslosh._core import Fluid, FluidMesh, RailsloshError
 from railslosh.constants import GRAVITY
 
@@ -206,6 +206,7 @@ def run(
     iterations). Together with ``stream`` this restarts long runs without losing or changing
     anything.
     """
+    wall_damping_ratio = limits.check("wall_damping_ratio", wall_damping_ratio)
     motion = motion or Motion()
     unknown = set(motion.acceleration) - set(AXES)
     if unknown:

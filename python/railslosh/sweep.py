@@ -20,14 +20,17 @@ from __future__ import annotations
 import itertools
 import os
 import time
-import tomllib
 from collections.abc import Mapping, Sequence
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-__all__ = ["ALIASES", "grid_overrides", "parse_grid", "parse_value", "run_point", "run_sweep"]
+from railslosh import results, scene
+from railslosh.limits import invalid, suggest
+from railslosh.scene.load import parse_value, set_dotted
+from railslosh.slosh import SimulationError
+
+__all__ = ["ALIASES", "grid_overrides", "parse_grid", "parse_value", "run_point", "run_sweep", "sweep_points"]
 
 ALIASES = {
     "oil": "fluid.oil",
@@ -41,14 +44,6 @@ ALIASES = {
 _BRAKING = {"ecp": "all", "conventional": "front", "all": "all", "front": "front"}
 
 
-def parse_value(text: str) -> Any:
-    """A TOML value (``0.5``, ``true``, ``[1, 2]``, ``"x"``), or the bare text as a string."""
-    try:
-        return tomllib.loads(f"v = {text}")["v"]
-    except tomllib.TOMLDecodeError:
-        return text.strip()
-
-
 def parse_grid(specs: Sequence[str]) -> dict[str, list[Any]]:
     """``["oil=light,heavy", "fill=0.5,0.7"]`` -> ``{"oil": ["light", "heavy"], "fill": [0.5, 0.7]}``."""
     grid: dict[str, list[Any]] = {}
@@ -56,26 +51,30 @@ def parse_grid(specs: Sequence[str]) -> dict[str, list[Any]]:
         name, sep, values = spec.partition("=")
         name = name.strip()
         if not sep or not name or not values.strip():
-            raise ValueError(f"invalid parameter `--grid` = {spec!r}: allowed NAME=V1,V2,...")
+            raise invalid("--grid", spec, "NAME=V1,V2,... (e.g. --grid oil=light,heavy)")
         if name in grid:
-            raise ValueError(f"invalid parameter `--grid {name}`: given twice")
+            raise invalid(f"--grid {name}", values, f"one --grid {name}=... (it is given twice)")
         vals = [parse_value(v) for v in values.split(",") if v.strip()]
         if len(set(map(repr, vals))) != len(vals):
-            raise ValueError(f"invalid parameter `--grid {name}` = {values!r}: allowed distinct values")
+            raise invalid(f"--grid {name}", values, "distinct values")
         grid[name] = vals
     return grid
 
 
 def _set(over: dict[str, Any], dotted: str, value: Any) -> None:
-    keys = dotted.split(".")
-    if len(keys) != 2 or not all(keys):
-        raise ValueError(f"invalid parameter `{dotted}`: allowed a grid name ({', '.join(ALIASES)}) or section.key")
-    over.setdefault(keys[0], {})[keys[1]] = value
+    if "." not in dotted:
+        close = suggest(dotted, ALIASES)
+        hint = f" (did you mean `{close}`?)" if close else ""
+        raise ValueError(
+            f"invalid `--grid {dotted}`: unknown grid name{hint}; expected one of {', '.join(ALIASES)} "
+            "or a scene field section.key"
+        )
+    set_dotted(over, dotted, value, option=f"--grid {dotted}")
 
 
 def _bulkheads(n: Any, tank_length: float = 12.0) -> list[list[float]]:
     if isinstance(n, bool) or not isinstance(n, int) or not 0 <= n <= 5:
-        raise ValueError(f"invalid parameter `bulkheads` = {n!r}: allowed an integer 0 to 5 (equally spaced)")
+        raise invalid("bulkheads", n, "a number of equally spaced bulkheads from 0 to 5")
     shell = tank_length - 1.0
     return [[round(-shell / 2 + shell * (k + 1) / (n + 1), 6), 0.02] for k in range(n)]
 
@@ -87,7 +86,7 @@ def grid_overrides(base: Mapping[str, Any], point: Mapping[str, Any]) -> dict[st
     for name, value in point.items():
         if name == "braking":
             if value not in _BRAKING:
-                raise ValueError(f"invalid parameter `braking` = {value!r}: allowed one of {', '.join(_BRAKING)}")
+                raise invalid("braking", value, f"one of {', '.join(_BRAKING)}")
             _set(over, "brake.scope", _BRAKING[value])
         elif name == "bulkheads":
             # overall tank length: the car's (shell + two 0.5 m heads) or a slosh tank's shell + 1 m
@@ -114,9 +113,6 @@ def run_point(base: Mapping[str, Any], overrides: Mapping[str, Any]) -> Any:
     """Runs one grid point; returns its Dataset on the scene's uniform time grid (slosh runs, which
     record every adaptive step, are interpolated onto multiples of ``solver.step``), with the run's
     ``wall_time``, ``steps`` and ``error`` (empty when it finished) as scalar variables."""
-    from railslosh import results, scene
-    from railslosh.slosh import SimulationError
-
     sc = scene.load_scene(base, overrides)
     t0 = time.perf_counter()
     error = ""
@@ -154,6 +150,32 @@ def _client(scheduler: str | None, workers: int, processes: bool) -> Any:
     return Client(cluster)
 
 
+def sweep_points(
+    scene_source: str | os.PathLike[str] | Mapping[str, Any],
+    grid: Mapping[str, Sequence[Any]],
+    overrides: Mapping[str, Any] | None = None,
+) -> tuple[dict[str, Any], list[str], list[dict[str, Any]], list[dict[str, Any]]]:
+    """The parsed scene (``overrides`` merged), the grid names, every point of ``grid`` and its
+    scene overrides, each point checked (its scene loads): a bad value raises ``ValueError`` naming
+    the point and the field, before anything runs."""
+    if not grid:
+        raise invalid("grid", {}, "at least one NAME=V1,V2,...")
+    base = scene.read_scene(scene_source)
+    if overrides:
+        base = scene.merge(base, overrides)
+    names = list(grid)
+    points = [dict(zip(names, combo, strict=True)) for combo in itertools.product(*(grid[n] for n in names))]
+    overs = []
+    for pt in points:
+        over = grid_overrides(base, pt)
+        try:
+            scene.load_scene(base, over)
+        except ValueError as exc:
+            raise ValueError(f"sweep point {pt}: {exc}") from exc
+        overs.append(over)
+    return base, names, points, overs
+
+
 def run_sweep(
     scene_source: str | os.PathLike[str] | Mapping[str, Any],
     grid: Mapping[str, Sequence[Any]],
@@ -174,31 +196,7 @@ def run_sweep(
     early hold the results up to the failure (NaN after it) and their message in ``error``."""
     import xarray as xr
 
-    from railslosh import scene
-
-    if not grid:
-        raise ValueError("invalid parameter `grid` = {}: allowed at least one NAME=V1,V2,...")
-    if isinstance(scene_source, Mapping):
-        base: dict[str, Any] = dict(scene_source)
-    else:
-        p = Path(scene_source)
-        try:
-            base = tomllib.loads(p.read_text(encoding="utf-8"))
-        except tomllib.TOMLDecodeError as exc:
-            raise ValueError(f"invalid scene TOML in {p}: {exc}") from exc
-    if overrides:
-        base = scene._merge(base, overrides)
-    names = list(grid)
-    points = [dict(zip(names, combo, strict=True)) for combo in itertools.product(*(grid[n] for n in names))]
-    overs = []
-    for pt in points:
-        over = grid_overrides(base, pt)
-        try:
-            scene.load_scene(base, over)
-        except ValueError as exc:
-            raise ValueError(f"sweep point {pt}: {exc}") from exc
-        overs.append(over)
-
+    base, names, points, overs = sweep_points(scene_source, grid, overrides)
     own = client is None
     if own:
         client = _client(scheduler, workers or os.cpu_count() or 1, processes)

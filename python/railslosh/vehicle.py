@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from railslosh import _core
+from railslosh import _core, limits
 from railslosh.slosh import SimulationError
 
 WALL_DAMPING_RATIO: float = _core.WALL_DAMPING_RATIO
@@ -201,8 +201,11 @@ def run_fluid(
     ``progress`` and ``stream`` work as in :func:`run`. ``wall_damping_ratio`` (0 to 10, default
     :data:`WALL_DAMPING_RATIO`) is the damping ratio of the liquid column on the penalty wall
     spring: 1 (critical) removes most of the 20-30 Hz wall ringing from the loads after a wave
-    hits a head, at about 1.35x the run time (docs/validation.md, "Wall damping").
+    hits a head, at about 1.35x the run time (docs/validation.md, "Wall damping"). ``fill`` is the
+    liquid volume fraction, :data:`railslosh.limits.FILL` (0.03 to 0.97, as in scenes).
     """
+    fill = limits.check("fill", fill)
+    wall_damping_ratio = limits.check("wall_damping_ratio", wall_damping_ratio)
     drive_speed, times, torques = _drive_and_brake(drive, speed, brake)
     res = dict(
         _core.run_fluid_train(
@@ -255,6 +258,7 @@ def equivalent_model(
     entry of ``modes`` per compartment (``mass`` m1, ``fixed_mass`` m0, ``omega``, ``frequency``,
     ``damping_ratio``, ``position``, ``pendulum_length``, ``compartment_length``). ``fill`` is the liquid
     volume fraction, as in :func:`run_fluid`."""
+    fill = limits.check("fill", fill)
     return dict(
         _core.equivalent_model(
             fill,
@@ -303,6 +307,7 @@ def run_equivalent(
     ``equivalent_model``."""
     if slosh_axis not in SLOSH_AXES:
         raise ValueError(f"invalid parameter `slosh_axis` = {slosh_axis!r}: allowed one of {', '.join(SLOSH_AXES)}")
+    fill = limits.check("fill", fill)
     drive_speed, times, torques = _drive_and_brake(drive, speed, brake)
     res = dict(
         _core.run_equivalent_train(
