@@ -2,7 +2,10 @@
 
 Penalty parameters (seed 000 §4.1): ``bulk_penalty`` k_IC is a bulk modulus (Pa) and
 ``bulk_damping`` c_TD a bulk viscosity (Pa s). When ``bulk_penalty`` is not given it follows
-:func:`default_bulk_penalty`.
+:func:`default_bulk_penalty`. ``shear_stabilization`` G_s (Pa) is the zero-energy-mode control
+that makes the discrete liquid's rest state stable (``ancf_core::constitutive``, "Shear
+stabilization"), off by default; :func:`default_shear_stabilization` gives the recommended value
+(scene key ``mesh.shear_stabilization``).
 """
 
 from __future__ import annotations
@@ -40,6 +43,14 @@ def default_bulk_damping(bulk_penalty: float, density: float, element_height: fl
     return _core.default_bulk_damping(bulk_penalty, density, element_height)
 
 
+def default_shear_stabilization(density: float, element_height: float) -> float:
+    """Recommended shear stabilization G_s = 0.006 rho g h_el (Pa) for elements ``element_height``
+    m high (``rail_mbs::defaults::default_shear_stabilization``): the smallest factor, with a
+    margin, that makes the rest state of the default meshes stable; it also raises the first
+    sloshing frequency by about 0.8 % on coarse meshes (docs/validation.md)."""
+    return _core.default_shear_stabilization(density, element_height)
+
+
 def _penalty(density: float, bulk_penalty: float | None, depth: float) -> float:
     return default_bulk_penalty(density, depth) if bulk_penalty is None else bulk_penalty
 
@@ -50,6 +61,7 @@ def newtonian(
     *,
     bulk_penalty: float | None = None,
     bulk_damping: float = 0.0,
+    shear_stabilization: float = 0.0,
     depth: float = 1.5,
 ) -> Fluid:
     """Newtonian fluid sigma = 2 mu D."""
@@ -59,6 +71,7 @@ def newtonian(
         viscosity=viscosity,
         bulk_penalty=_penalty(density, bulk_penalty, depth),
         bulk_damping=bulk_damping,
+        shear_stabilization=shear_stabilization,
     )
 
 
@@ -69,6 +82,7 @@ def bingham(
     *,
     bulk_penalty: float | None = None,
     bulk_damping: float = 0.0,
+    shear_stabilization: float = 0.0,
     depth: float = 1.5,
     shear_rate_reg: float = 1e-2,
 ) -> Fluid:
@@ -80,6 +94,7 @@ def bingham(
         yield_stress=yield_stress,
         bulk_penalty=_penalty(density, bulk_penalty, depth),
         bulk_damping=bulk_damping,
+        shear_stabilization=shear_stabilization,
         shear_rate_reg=shear_rate_reg,
     )
 
@@ -92,6 +107,7 @@ def herschel_bulkley(
     *,
     bulk_penalty: float | None = None,
     bulk_damping: float = 0.0,
+    shear_stabilization: float = 0.0,
     depth: float = 1.5,
     shear_rate_reg: float = 1e-2,
 ) -> Fluid:
@@ -104,6 +120,7 @@ def herschel_bulkley(
         yield_stress=yield_stress,
         bulk_penalty=_penalty(density, bulk_penalty, depth),
         bulk_damping=bulk_damping,
+        shear_stabilization=shear_stabilization,
         shear_rate_reg=shear_rate_reg,
     )
 
@@ -116,6 +133,7 @@ def oldroyd(
     elastic_modulus: float | None = None,
     bulk_penalty: float | None = None,
     bulk_damping: float = 0.0,
+    shear_stabilization: float = 0.0,
     depth: float = 1.5,
     shear_rate_reg: float = 1e-2,
 ) -> Fluid:
@@ -128,6 +146,7 @@ def oldroyd(
         elastic_modulus=elastic_modulus,
         bulk_penalty=_penalty(density, bulk_penalty, depth),
         bulk_damping=bulk_damping,
+        shear_stabilization=shear_stabilization,
         shear_rate_reg=shear_rate_reg,
     )
 
@@ -139,6 +158,7 @@ def casson(
     *,
     bulk_penalty: float | None = None,
     bulk_damping: float = 0.0,
+    shear_stabilization: float = 0.0,
     depth: float = 1.5,
     shear_rate_reg: float = 1e-2,
 ) -> Fluid:
@@ -150,6 +170,7 @@ def casson(
         yield_stress=yield_stress,
         bulk_penalty=_penalty(density, bulk_penalty, depth),
         bulk_damping=bulk_damping,
+        shear_stabilization=shear_stabilization,
         shear_rate_reg=shear_rate_reg,
     )
 

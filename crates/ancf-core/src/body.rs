@@ -247,6 +247,18 @@ impl FluidBody {
             .sum()
     }
 
+    /// Stored energy of the shear stabilization, Σ ∫ G_s dev(E):dev(E) dV₀ (J); 0 without it.
+    pub fn stabilization_energy(&self, e: &[f64]) -> f64 {
+        if self.fluid.shear_stabilization == 0.0 {
+            return 0.0;
+        }
+        self.elements
+            .iter()
+            .zip(&self.mesh.elements)
+            .map(|(el, nodes)| el.stabilization_energy(&gather_compact_flat(e, nodes), &self.tables, &self.fluid))
+            .sum()
+    }
+
     /// The smallest volume ratio J = det F over every quadrature point of every element
     /// (all three rules, see [`ElementRef::volume_ratio_range`]) and the largest.
     pub fn volume_ratio_range(&self, e: &[f64]) -> VolumeRatioRange {

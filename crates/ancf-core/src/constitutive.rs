@@ -49,6 +49,23 @@
 //! element's stress-free reference, so a fluid that has flowed far is always in the
 //! yielded (Bingham) branch. τ₀ = 0 gives the Newtonian fluid exactly.
 //!
+//! # Shear stabilization (zero-energy-mode control)
+//! A liquid has no shear stiffness, and the discrete one inherits modes that the penalty and
+//! the walls do not hold: linearized about the hydrostatic rest state, the hydrostatic
+//! pre-stress gives some of them a small *negative* stiffness (the rest state of the default
+//! discretization is unstable: `docs/validation.md`, "A stable rest state"). The optional
+//! [`Fluid::shear_stabilization`] G_s (Pa) adds the deviatoric St-Venant–Kirchhoff stress
+//! P_s = F 2G_s dev(E), E = ½(FᵀF − I), the same elastic law as the Oldroyd gel branch, with the
+//! stored energy ∫ G_s dev(E):dev(E) dV₀ ([`Fluid::stabilization_energy_density`]). It is
+//! objective (zero for rigid motions) and zero at the reference. With G_s a small fraction of
+//! the hydrostatic pressure ρgH it removes the unstable rest modes of the rectangular and SwRI
+//! tanks while moving the first sloshing frequency by about 2 G_s/(ρgH) (measured in
+//! docs/validation.md); like the seed's Oldroyd gel, E is measured from the stress-free
+//! reference, so its stress stays of order G_s · strain, far below ρgH in a sloshing liquid.
+//! Zero (the default of [`Fluid::new`]) leaves the fluid exactly as before; runs opt in with
+//! the recommended `rail_mbs::defaults::default_shear_stabilization`, because it also
+//! stiffens the sloshing itself (measured in docs/validation.md, "A stable rest state").
+//!
 //! # Newtonian fast path
 //! When 2η(s) is a constant and there is no elastic branch ([`Fluid::newtonian_two_eta`]:
 //! Newtonian, and Bingham, Oldroyd, Casson with τ₀ = 0, Herschel–Bulkley with τ₀ = 0 and
@@ -238,6 +255,9 @@ pub struct Fluid {
     pub shear_rate_reg: f64,
     /// Relative half-width w of the Oldroyd elastic/viscous blend.
     pub oldroyd_switch_width: f64,
+    /// Shear stabilization modulus G_s (Pa) of the zero-energy-mode control (module docs,
+    /// "Shear stabilization"); 0 disables it.
+    pub shear_stabilization: f64,
 }
 
 impl Fluid {
@@ -251,6 +271,7 @@ impl Fluid {
             bulk_damping: 0.0,
             shear_rate_reg: 1e-2,
             oldroyd_switch_width: 0.05,
+            shear_stabilization: 0.0,
         };
         f.validate()?;
         Ok(f)
@@ -264,6 +285,7 @@ impl Fluid {
         check_non_negative("bulk_damping", self.bulk_damping)?;
         check_positive("shear_rate_reg", self.shear_rate_reg)?;
         check_range("oldroyd_switch_width", self.oldroyd_switch_width, 1e-4, 0.5)?;
+        check_non_negative("shear_stabilization", self.shear_stabilization)?;
         Ok(())
     }
 
@@ -317,10 +339,49 @@ impl Fluid {
         tangents: Option<(&mut Tangent, &mut Tangent)>,
         path: DeviatoricPath,
     ) -> Option<M3> {
+        let gs = self.shear_stabilization;
+        if gs == 0.0 {
+            return self.rheology_stress(f, fdot, tangents, path);
+        }
+        let (p, tf) = match tangents {
+            Some((tf, tv)) => (self.rheology_stress(f, fdot, Some((&mut *tf, tv)), path)?, Some(tf)),
+            None => (self.rheology_stress(f, fdot, None, path)?, None),
+        };
+        let se = svk_deviatoric_stress(f, gs);
+        if let Some(tf) = tf {
+            for kl in 0..9 {
+                let mut dx = M3::zeros();
+                dx[(kl / 3, kl % 3)] = 1.0;
+                let (_, dpe) = svk_deviatoric_derivative(f, &se, &dx, gs);
+                for ij in 0..9 {
+                    tf[ij][kl] += dpe[(ij / 3, ij % 3)];
+                }
+            }
+        }
+        Some(p + f * se)
+    }
+
+    /// The stress of the rheological law alone (without the shear stabilization), by the
+    /// chosen kernel.
+    #[inline]
+    fn rheology_stress(
+        &self,
+        f: &M3,
+        fdot: &M3,
+        tangents: Option<(&mut Tangent, &mut Tangent)>,
+        path: DeviatoricPath,
+    ) -> Option<M3> {
         match (path, self.newtonian_two_eta()) {
             (DeviatoricPath::Auto, Some(two_eta)) => newtonian_stress(two_eta, f, fdot, tangents),
             _ => self.deviatoric_stress_generic(f, fdot, tangents),
         }
+    }
+
+    /// Stored energy density G_s dev(E):dev(E) (J/m³ of reference volume) of the shear
+    /// stabilization, whose derivative with respect to F is its stress F 2G_s dev(E).
+    pub fn stabilization_energy_density(&self, f: &M3) -> f64 {
+        let de = dev(&(0.5 * (f.transpose() * f - M3::identity())));
+        self.shear_stabilization * de.component_mul(&de).sum()
     }
 
     /// The generic kernel: any law, tangents by directional derivatives.
@@ -347,8 +408,7 @@ impl Fluid {
         let elastic = if self.has_elastic_branch() {
             let tau0 = self.rheology.yield_stress();
             let gmod = self.elastic_modulus();
-            let e = 0.5 * (f.transpose() * f - M3::identity());
-            let se = 2.0 * gmod * dev(&e);
+            let se = svk_deviatoric_stress(f, gmod);
             let ne = (0.5 * se.component_mul(&se).sum()).sqrt();
             let w = self.oldroyd_switch_width;
             let t = (ne - tau0 * (1.0 - w)) / (2.0 * w * tau0);
@@ -376,9 +436,7 @@ impl Fluid {
                 let dpb = (da * ds * j + a * dj) * d * gt + (a * j) * (dd * gt + d * dg.transpose());
                 let dp_f = match elastic {
                     Some((se, ne, phi, dphi, gmod)) => {
-                        let de = 0.5 * (f.transpose() * dx + dx.transpose() * f);
-                        let dse = 2.0 * gmod * dev(&de);
-                        let dpe = dx * se + f * dse;
+                        let (dse, dpe) = svk_deviatoric_derivative(f, &se, &dx, gmod);
                         let dne = if ne > 0.0 { se.component_mul(&dse).sum() / (2.0 * ne) } else { 0.0 };
                         (1.0 - phi) * dpe + phi * dpb + (dphi * dne) * (pb - f * se)
                     }
@@ -502,6 +560,21 @@ pub fn newtonian_stress(two_eta: f64, f: &M3, fdot: &M3, tangents: Option<(&mut 
 #[inline]
 pub fn dev(m: &M3) -> M3 {
     m - M3::identity() * (m.trace() / 3.0)
+}
+
+/// Second Piola stress S_e = 2G dev(E), E = ½(FᵀF − I), of the deviatoric St-Venant–Kirchhoff
+/// law (the Oldroyd gel branch and the shear stabilization); its first Piola stress is F S_e.
+#[inline]
+pub fn svk_deviatoric_stress(f: &M3, g: f64) -> M3 {
+    2.0 * g * dev(&(0.5 * (f.transpose() * f - M3::identity())))
+}
+
+/// The derivatives of [`svk_deviatoric_stress`] S_e and of F S_e along dF: (dS_e, d(F S_e)).
+#[inline]
+pub fn svk_deviatoric_derivative(f: &M3, se: &M3, dx: &M3, g: f64) -> (M3, M3) {
+    let de = 0.5 * (f.transpose() * dx + dx.transpose() * f);
+    let dse = 2.0 * g * dev(&de);
+    (dse, dx * se + f * dse)
 }
 
 /// Cofactor matrix ∂(det F)/∂F = [f₂×f₃, f₃×f₁, f₁×f₂] (columns).

@@ -282,6 +282,20 @@ impl ElementRef {
             .sum()
     }
 
+    /// Stored energy of the shear stabilization, ∫ G_s dev(E):dev(E) dV₀ over the viscous rule
+    /// (where its stress is evaluated, with the deviatoric one).
+    pub fn stabilization_energy(&self, e: &Compact, tables: &ShapeTables, fluid: &Fluid) -> f64 {
+        if fluid.shear_stabilization == 0.0 {
+            return 0.0;
+        }
+        let ehat = scaled(e, &self.scale);
+        self.viscous
+            .iter()
+            .zip(&tables.viscous.dn)
+            .map(|(rp, dn)| fluid.stabilization_energy_density(&(grad_xi(&ehat, dn) * rp.jinv)) * rp.wdet)
+            .sum()
+    }
+
     /// Smallest and largest volume ratio J = det F over every point of the viscous,
     /// penalty and mass rules and the check points ([`ShapeTables::check`]), with the
     /// index of the point of the smallest (numbered viscous points first, then penalty,

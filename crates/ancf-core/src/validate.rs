@@ -115,16 +115,25 @@ impl Rng {
     }
 }
 
-/// The five rheologies with representative parameters, and a penalty.
+/// The five rheologies with representative parameters, and a penalty; the sixth is the
+/// Newtonian one with the shear stabilization ([`Fluid::shear_stabilization`]).
 pub fn sample_fluids() -> Vec<Fluid> {
     let mk = |rheology| Fluid { bulk_damping: 20.0, ..Fluid::new(900.0, rheology, 2.0e5).expect("valid") };
+    let newtonian = mk(Rheology::Newtonian { viscosity: 0.8 });
     vec![
-        mk(Rheology::Newtonian { viscosity: 0.8 }),
+        newtonian,
         mk(Rheology::Bingham { viscosity: 0.5, yield_stress: 3.0 }),
         mk(Rheology::HerschelBulkley { consistency: 0.7, power_index: 0.6, yield_stress: 2.0 }),
         mk(Rheology::Oldroyd { viscosity: 0.5, yield_stress: 40.0, elastic_modulus: Some(800.0) }),
         mk(Rheology::Casson { viscosity: 0.4, yield_stress: 2.5 }),
+        Fluid { shear_stabilization: 300.0, ..newtonian },
     ]
+}
+
+/// The name of a sample fluid in records: its law, and "+ shear stabilization" when it has one.
+pub fn sample_label(fluid: &Fluid) -> String {
+    let name = fluid.rheology.name();
+    if fluid.shear_stabilization > 0.0 { format!("{name} + shear stabilization") } else { name.to_string() }
 }
 
 fn element_mass() -> Result<Vec<Record>> {
@@ -299,7 +308,7 @@ fn element_jacobians(samples: usize) -> Result<Vec<Record>> {
             ek = ek.max(a);
             ec = ec.max(b);
         }
-        let name = fluid.rheology.name();
+        let name = sample_label(&fluid);
         out.push(Record::at_most(
             c,
             format!("{name}: max relative FD error of K = df/de ({samples} random states)"),
@@ -352,7 +361,7 @@ fn rigid_motion_invariance(samples: usize) -> Result<Vec<Record>> {
             let s = f1.iter().fold(0.0f64, |m, x| m.max(x.abs()));
             objectivity = objectivity.max(f1r.iter().zip(&f2).fold(0.0f64, |m, (a, b)| m.max((a - b).abs())) / s);
         }
-        let name = fluid.rheology.name();
+        let name = sample_label(&fluid);
         out.push(Record::at_most(
             c,
             format!("{name}: max |f| under rigid motion, relative to a deforming state"),

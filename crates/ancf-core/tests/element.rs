@@ -186,6 +186,53 @@ fn penalty_force_matches_energy_derivative_under_dilation() {
     assert!((el.volume_current(&to_compact(&es), &tables) - 1.0).abs() < 1e-13);
 }
 
+/// The shear stabilization's force is the gradient of its stored energy (so the energy
+/// balance that counts it is exact), vanishes at the reference and under a rigid rotation,
+/// and resists an isochoric shear (positive work along it).
+#[test]
+fn shear_stabilization_force_is_the_gradient_of_its_energy() {
+    let tables = ShapeTables::new(QuadratureOptions::default()).unwrap();
+    let l = [0.4, 0.3, 0.2];
+    let e0 = box_element([0.0; 3], l);
+    let el = ElementRef::new(0, &e0, l, &tables).unwrap();
+    let gs = 40.0;
+    let fluid =
+        Fluid { shear_stabilization: gs, ..Fluid::new(1000.0, Rheology::Newtonian { viscosity: 0.0 }, 0.0).unwrap() };
+    let zero = [[0.0; 3]; N_SHAPE];
+    let force = |e: &[f64]| {
+        let mut f = [0.0; N_COORDS];
+        el.internal_force(0, &fluid, &tables, &to_compact(e), &zero, &mut f, None).unwrap();
+        f
+    };
+    let energy = |e: &[f64]| el.stabilization_energy(&to_compact(e), &tables, &fluid);
+    // at the reference and under a finite rotation: no force, no energy
+    let rot = nalgebra::Rotation3::from_euler_angles(0.3, -0.5, 0.8);
+    for e in [flat(&e0), affine(&e0, rot.matrix(), [0.2, -0.1, 0.4])] {
+        assert!(force(&e).iter().all(|x| x.abs() < 1e-12 * gs), "stabilization force at a rigid state");
+        assert!(energy(&e).abs() < 1e-14 * gs);
+    }
+    // a deformed state: f = dW/de by central differences along random directions
+    let mut rng = Rng::new(5);
+    let e: Vec<f64> = flat(&e0).iter().map(|x| x + 0.05 * rng.uniform()).collect();
+    let f = force(&e);
+    for _ in 0..5 {
+        let d: Vec<f64> = e.iter().map(|_| rng.uniform()).collect();
+        let h = 1e-6;
+        let ep: Vec<f64> = e.iter().zip(&d).map(|(a, b)| a + h * b).collect();
+        let em: Vec<f64> = e.iter().zip(&d).map(|(a, b)| a - h * b).collect();
+        let fd = (energy(&ep) - energy(&em)) / (2.0 * h);
+        let an: f64 = f.iter().zip(&d).map(|(a, b)| a * b).sum();
+        assert!((fd - an).abs() < 1e-6 * an.abs().max(1e-3), "dW/de {fd} vs f.d {an}");
+    }
+    // simple shear gamma: W = G_s |dev E|^2 V with E = [[0, g/2, 0], [g/2, g^2/2, 0], [0, 0, 0]]
+    let g = 0.1;
+    let es = affine(&e0, &M3::new(1.0, g, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0), [0.0; 3]);
+    let e_ = M3::new(0.0, g / 2.0, 0.0, g / 2.0, g * g / 2.0, 0.0, 0.0, 0.0, 0.0);
+    let de = e_ - M3::identity() * (e_.trace() / 3.0);
+    let exact = gs * de.component_mul(&de).sum() * l[0] * l[1] * l[2];
+    assert!((energy(&es) / exact - 1.0).abs() < 1e-12, "{} vs {exact}", energy(&es));
+}
+
 fn forces(fluid: &Fluid, body: &FluidBody, e: &[f64], v: &[f64]) -> Vec<f64> {
     let b = FluidBody::new(body.mesh.clone(), *fluid, QuadratureOptions::default()).unwrap();
     let mut f = vec![0.0; b.n_coords()];

@@ -50,8 +50,24 @@ pub fn default_bulk_damping(bulk_penalty: f64, density: f64, h_el: f64) -> f64 {
     0.2 * (bulk_penalty * density).sqrt() * h_el
 }
 
+/// Recommended shear stabilization modulus as a fraction of the hydrostatic pressure over one
+/// element height: G_s = SHEAR_STABILIZATION · ρ g h_el ([`default_shear_stabilization`]).
+pub const SHEAR_STABILIZATION: f64 = 0.006;
+
+/// Recommended shear stabilization G_s = [`SHEAR_STABILIZATION`] ρ g h_el (Pa) for elements
+/// `h_el` m high (`ancf_core::constitutive`, "Shear stabilization"). The unstable rest modes it
+/// removes are discretization errors that shrink as the mesh is refined, so G_s shrinks with
+/// the element. The factor is the smallest that made the rest state of the rectangular tank's
+/// 4×8×3 mesh stable, with a margin. It is not applied by default: it also stiffens the
+/// sloshing (first frequency +0.8 % and twice the RMS difference to linear potential flow on
+/// the 2×6×2 tank), so runs opt in (scene key `mesh.shear_stabilization`); the measurements
+/// are in docs/validation.md, "A stable rest state".
+pub fn default_shear_stabilization(density: f64, h_el: f64) -> f64 {
+    SHEAR_STABILIZATION * density * GRAVITY * h_el
+}
+
 /// A fluid with the default penalties for liquid depth `depth` and element height `h_el`:
-/// [`default_bulk_penalty`] and [`default_bulk_damping`].
+/// [`default_bulk_penalty`] and [`default_bulk_damping`] (no shear stabilization).
 pub fn liquid(density: f64, rheology: Rheology, depth: f64, h_el: f64) -> Result<Fluid> {
     let k = default_bulk_penalty(density, depth, PENALTY_STRAIN)?;
     let mut f = Fluid::new(density, rheology, k)?;

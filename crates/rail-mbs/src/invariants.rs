@@ -179,7 +179,7 @@ pub fn wall_power(force: [f64; 3], moment: [f64; 3], kin: &TankKinematics) -> f6
 
 /// Stored elastic energy of one liquid: penalty + contact springs (J).
 pub fn stored_energy(body: &FluidBody, contact: &WallContact, kin: &TankKinematics, q: &[f64]) -> f64 {
-    body.penalty_energy(q) + contact.stored_energy(body, kin, q)
+    body.penalty_energy(q) + body.stabilization_energy(q) + contact.stored_energy(body, kin, q)
 }
 
 /// The state invariants of one liquid (`what()` names it in errors; called only then): containment within

@@ -191,30 +191,46 @@ fn a_liquid_at_rest_stays_at_rest_with_flat_energy() {
     assert!(m.worst_gap < 3e-3 * L[2], "{m:?}");
 }
 
-/// λ_min = ω²_min H/g of the SwRI tank (seed 003) on the shipped scenes' 1×2×2 mesh, about
-/// its rest state settled by dynamic relaxation (viscosity 10⁴ Pa·s, 3 s), with the force
-/// points per direction `np` and contact points per face edge `ppe`.
-fn swri_rest_lambda_min(np: usize, ppe: usize, walls: f64) -> f64 {
+/// The meshes whose rest state is checked: the rectangular tank of seed 003 and the SwRI tank.
+#[derive(Clone, Copy, Debug)]
+enum RestMesh {
+    /// 0.416 × 0.324 m, water 0.132 m deep, with these element counts.
+    Box([usize; 3]),
+    /// The SwRI elliptic tank (seed 003), half full of water.
+    Swri([usize; 3]),
+}
+
+/// λ_min = ω²_min H/g of `mesh` about its rest state settled by dynamic relaxation (viscosity
+/// 10⁴ Pa·s, 3 s), with the force points per direction `np`, contact points per face edge
+/// `ppe`, and the shear stabilization `g_s` (Pa; `None`: the recommended
+/// `default_shear_stabilization` for the mesh's element height).
+fn rest_lambda_min(mesh: RestMesh, np: usize, ppe: usize, stabilization: Option<f64>) -> f64 {
     use ancf_core::mesh::{EllipticCylinderSpec, elliptic_cylinder};
     use rail_mbs::slosh::linear_modes;
-    let spec = EllipticCylinderSpec::swri(1, 2, 2);
-    let mesh = elliptic_cylinder(&spec).unwrap();
-    let depth = mesh.free_surface_z - mesh.nodes.iter().map(|n| n[2]).fold(f64::INFINITY, f64::min);
-    let mut fluid = liquid(RHO, Rheology::Newtonian { viscosity: 1e-3 }, depth, depth / 2.0).unwrap();
+    let (mesh, geo, depth, layers) = match mesh {
+        RestMesh::Box(c) => {
+            let lo = [-0.5 * L[0], -0.5 * L[1], 0.0];
+            let geo = TankGeometry::new(TankShape::Box { min: lo, max: [0.5 * L[0], 0.5 * L[1], 0.3] }, vec![]);
+            (box_mesh(lo, L, c).unwrap(), geo.unwrap(), L[2], c[2])
+        }
+        RestMesh::Swri(c) => {
+            let spec = EllipticCylinderSpec::swri(c[0], c[1], c[2]);
+            let mesh = elliptic_cylinder(&spec).unwrap();
+            let depth = mesh.free_surface_z - mesh.nodes.iter().map(|n| n[2]).fold(f64::INFINITY, f64::min);
+            let shape = TankShape::EllipticCylinder {
+                length: spec.length,
+                semi_axis_y: spec.semi_axis_y,
+                semi_axis_z: spec.semi_axis_z,
+            };
+            (mesh, TankGeometry::new(shape, vec![]).unwrap(), depth, c[2])
+        }
+    };
+    let h_el = depth / layers as f64;
+    let mut fluid = liquid(RHO, Rheology::Newtonian { viscosity: 1e-3 }, depth, h_el).unwrap();
+    fluid.shear_stabilization = stabilization.unwrap_or(rail_mbs::defaults::default_shear_stabilization(RHO, h_el));
     fluid.rheology = Rheology::Newtonian { viscosity: 1e4 };
     let body = FluidBody::new(mesh, fluid, QuadratureOptions { viscous: np, penalty: np, mass: 4 }).unwrap();
-    let geo = TankGeometry::new(
-        TankShape::EllipticCylinder {
-            length: spec.length,
-            semi_axis_y: spec.semi_axis_y,
-            semi_axis_z: spec.semi_axis_z,
-        },
-        vec![],
-    )
-    .unwrap();
-    let mut law = WallContactLaw { points_per_edge: ppe, ..WallContactLaw::default_for(RHO, G, depth) };
-    law.stiffness *= walls;
-    law.damping *= walls.powf(1.5);
+    let law = WallContactLaw { points_per_edge: ppe, ..WallContactLaw::default_for(RHO, G, depth) };
     let contact = WallContact::new(&body, geo, law).unwrap();
     let sys =
         SloshSystem::new(body, contact, PrescribedMotion::at_rest([0.0; 3]), [0.0, 0.0, -G], SloshFrame::Inertial)
@@ -223,20 +239,80 @@ fn swri_rest_lambda_min(np: usize, ppe: usize, walls: f64) -> f64 {
     run.run_to(3.0, 0.02).unwrap();
     let q = run.stepper.q().to_vec();
     let mut sys = run.stepper.into_system();
+    sys.body.fluid.rheology = Rheology::Newtonian { viscosity: 1e-3 };
     let modes = linear_modes(&mut sys, 3.0, &q).unwrap();
     modes.omega_sq[0] * depth / G
 }
 
-/// Measured (release): λ_min = −2.83 with the library's 3³ force points and 3×3 contact
-/// points (growth √(−λ g/H) = 14.5 1/s), −0.0173 with the shipped scenes' 4³ and 5×5 (1.1 1/s);
-/// 4³ 4×4: −0.0145, 5³ 5×5: −0.0172, 4³ 6×6: −0.0159; stiffer walls make it worse here
-/// (4³ 5×5 with walls ×10: −0.087, ×100: −0.228). The shipped settings remove 99 % of the
-/// instability but not all of it (a stable rest state would be λ_min ≥ −0.01): open, see
-/// docs/validation.md "Known gaps". This test keeps what was gained from regressing.
+/// Issue 16 §6: with the recommended shear stabilization the linearization about the settled
+/// rest state has no growing mode on the default and shipped meshes (release figures, docs/validation.md "A stable rest state"):
+///
+/// | mesh | quadrature (force points, contact points per edge) | λ_min without / with the recommended shear stabilization |
+/// |---|---|---|
+/// | rectangular tank 4×8×3 (`slosh-rect-tank` full) | 3³, 3×3 (library default) | −0.239 / +0.0046 |
+/// | rectangular tank 3×6×2 (`slosh-rect-tank` quick) | 4³, 4×4 | −0.113 / +0.0076 |
+/// | SwRI 1×2×2 (the shipped SwRI scenes) | 4³, 5×5 | −0.0173 / +0.0070 |
+/// | SwRI 2×4×4 (the refined SwRI mesh) | 3³, 3×3 | −0.113 / +0.0031 |
+///
+/// Without the stabilization each of them has a growing mode (so the test can fail).
 #[test]
-fn the_shipped_swri_settings_remove_most_of_the_rest_state_instability() {
-    let shipped = swri_rest_lambda_min(4, 5, 1.0);
-    let default = swri_rest_lambda_min(3, 3, 1.0);
-    assert!(default < -1.0, "the default discretization was measured at -2.83: {default}");
-    assert!(shipped > -0.02 && shipped > 0.01 * default, "shipped settings: lambda_min = {shipped}");
+fn the_rest_state_is_stable_on_the_default_and_shipped_meshes() {
+    for (mesh, np, ppe) in [
+        (RestMesh::Box([4, 8, 3]), 3, 3),
+        (RestMesh::Box([3, 6, 2]), 4, 4),
+        (RestMesh::Swri([1, 2, 2]), 4, 5),
+        (RestMesh::Swri([2, 4, 4]), 3, 3),
+    ] {
+        let stabilized = rest_lambda_min(mesh, np, ppe, None);
+        assert!(stabilized >= 0.0, "{mesh:?} {np}^3 {ppe}x{ppe}: lambda_min = {stabilized}");
+        let bare = rest_lambda_min(mesh, np, ppe, Some(0.0));
+        assert!(bare < -0.01, "{mesh:?} without the stabilization was measured unstable: {bare}");
+    }
+}
+
+/// The SwRI tank's coarse 1×2×2 mesh still needs the shipped scenes' 4³ force points and 5×5
+/// contact points: with the library's 3³ and 3×3 its rest state is unstable even with the
+/// stabilization (λ_min = −2.76; the stabilization scales with the element, and this mesh's
+/// fold is a quadrature artefact, docs/validation.md).
+#[test]
+fn the_coarse_swri_mesh_needs_the_shipped_quadrature() {
+    assert!(rest_lambda_min(RestMesh::Swri([1, 2, 2]), 3, 3, None) < -1.0);
+    assert!(rest_lambda_min(RestMesh::Swri([1, 2, 2]), 4, 5, None) > 0.0);
+}
+
+/// A tank at rest for 20 s keeps a flat energy: after the settling of the penalty pressure,
+/// the kinetic energy never grows again (SwRI tank, shipped 1×2×2 mesh and quadrature, with
+/// the recommended shear stabilization).
+#[test]
+fn a_tank_at_rest_for_20_s_keeps_a_flat_energy() {
+    use ancf_core::mesh::{EllipticCylinderSpec, elliptic_cylinder};
+    let spec = EllipticCylinderSpec::swri(1, 2, 2);
+    let mesh = elliptic_cylinder(&spec).unwrap();
+    let depth = mesh.free_surface_z - mesh.nodes.iter().map(|n| n[2]).fold(f64::INFINITY, f64::min);
+    let mut fluid = liquid(RHO, Rheology::Newtonian { viscosity: 1e-3 }, depth, depth / 2.0).unwrap();
+    fluid.shear_stabilization = rail_mbs::defaults::default_shear_stabilization(RHO, depth / 2.0);
+    let body = FluidBody::new(mesh, fluid, QuadratureOptions { viscous: 4, penalty: 4, mass: 4 }).unwrap();
+    let shape = TankShape::EllipticCylinder {
+        length: spec.length,
+        semi_axis_y: spec.semi_axis_y,
+        semi_axis_z: spec.semi_axis_z,
+    };
+    let law = WallContactLaw { points_per_edge: 5, ..WallContactLaw::default_for(RHO, G, depth) };
+    let contact = WallContact::new(&body, TankGeometry::new(shape, vec![]).unwrap(), law).unwrap();
+    let sys =
+        SloshSystem::new(body, contact, PrescribedMotion::at_rest([0.0; 3]), [0.0, 0.0, -G], SloshFrame::Inertial)
+            .unwrap();
+    let mgh = sys.body.total_mass() * G * depth;
+    let mut run = SloshRun::new(sys, 0.0, slosh_params()).unwrap();
+    run.run_to(20.0, 0.02).unwrap();
+    let r = &run.record;
+    let window = |a: f64, b: f64| {
+        r.t.iter().zip(&r.kinetic_energy).filter(|(t, _)| **t >= a && **t < b).fold(0.0f64, |m, (_, k)| m.max(*k))
+    };
+    let (settling, middle, late) = (window(0.0, 2.0), window(2.0, 10.0), window(10.0, 20.01));
+    assert!(settling < 1e-3 * mgh, "settling kinetic energy {settling} J (m g H = {mgh} J)");
+    assert!(middle < settling && late <= middle, "kinetic energy grows at rest: {settling}, {middle}, {late} J");
+    assert!(late < 1e-6 * mgh, "kinetic energy after 10 s at rest: {late} J (m g H = {mgh} J)");
+    let m = run.margins();
+    assert!(m.worst_energy_error < 1e-4, "{m:?}");
 }

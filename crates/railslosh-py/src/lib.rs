@@ -207,6 +207,18 @@ fn default_bulk_damping(bulk_penalty: f64, density: f64, element_height: f64) ->
     Ok(rail_mbs::defaults::default_bulk_damping(bulk_penalty, density, element_height))
 }
 
+/// Recommended shear stabilization G_s = 0.006 ρ g h_el, Pa
+/// (`rail_mbs::defaults::default_shear_stabilization`).
+#[pyfunction]
+fn default_shear_stabilization(density: f64, element_height: f64) -> PyResult<f64> {
+    for (field, value) in [("density", density), ("element_height", element_height)] {
+        if !(value.is_finite() && value >= 0.0) {
+            return Err(to_py(ancf_core::error::invalid(field, value, "a number >= 0")));
+        }
+    }
+    Ok(rail_mbs::defaults::default_shear_stabilization(density, element_height))
+}
+
 #[pyfunction]
 fn box_mesh(py: Python<'_>, origin: [f64; 3], size: [f64; 3], counts: [usize; 3]) -> PyResult<PyFluidMesh> {
     compute(py, || mesh::box_mesh(origin, size, counts)).map(|inner| PyFluidMesh { inner })
@@ -259,7 +271,8 @@ struct PyFluid {
 impl PyFluid {
     #[new]
     #[pyo3(signature = (density, model, *, viscosity=0.0, yield_stress=0.0, consistency=None, power_index=1.0,
-                        elastic_modulus=None, bulk_penalty, bulk_damping=0.0, shear_rate_reg=1e-2))]
+                        elastic_modulus=None, bulk_penalty, bulk_damping=0.0, shear_rate_reg=1e-2,
+                        shear_stabilization=0.0))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         density: f64,
@@ -272,6 +285,7 @@ impl PyFluid {
         bulk_penalty: f64,
         bulk_damping: f64,
         shear_rate_reg: f64,
+        shear_stabilization: f64,
     ) -> PyResult<Self> {
         let rheology = match model {
             "newtonian" => Rheology::Newtonian { viscosity },
@@ -287,7 +301,15 @@ impl PyFluid {
                 )));
             }
         };
-        let f = Fluid { density, rheology, bulk_penalty, bulk_damping, shear_rate_reg, oldroyd_switch_width: 0.05 };
+        let f = Fluid {
+            density,
+            rheology,
+            bulk_penalty,
+            bulk_damping,
+            shear_rate_reg,
+            oldroyd_switch_width: 0.05,
+            shear_stabilization,
+        };
         f.validate().map_err(to_py)?;
         Ok(Self { inner: f })
     }
@@ -310,6 +332,11 @@ impl PyFluid {
     #[getter]
     fn bulk_damping(&self) -> f64 {
         self.inner.bulk_damping
+    }
+    /// Shear stabilization modulus G_s, Pa (0: none).
+    #[getter]
+    fn shear_stabilization(&self) -> f64 {
+        self.inner.shear_stabilization
     }
     /// Shear modulus of the Oldroyd elastic branch (0 for other models).
     #[getter]
@@ -769,6 +796,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(crude_oils, m)?)?;
     m.add_function(wrap_pyfunction!(default_bulk_penalty, m)?)?;
     m.add_function(wrap_pyfunction!(default_bulk_damping, m)?)?;
+    m.add_function(wrap_pyfunction!(default_shear_stabilization, m)?)?;
     m.add_function(wrap_pyfunction!(box_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(cylinder_tank, m)?)?;
     m.add_function(wrap_pyfunction!(elliptic_cylinder, m)?)?;

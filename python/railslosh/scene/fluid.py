@@ -33,26 +33,31 @@ class FluidSpec:
     """``[tank] wall_damping_ratio``: damping ratio of the liquid column on the penalty wall (0 to 10;
     1 removes most wall ringing from the loads: :func:`railslosh.vehicle.run_fluid`)."""
 
-    def make_fluid(self, depth: float, element_height: float | None = None) -> Any:
+    def make_fluid(self, depth: float, element_height: float | None = None, shear_stabilization: bool = False) -> Any:
         """The :class:`railslosh.Fluid` for a liquid ``depth`` m deep: penalty ``k = 1000 rho g depth``
         and, when ``element_height`` is given, bulk damping ``0.2 sqrt(k rho) element_height`` (the
-        defaults of the slosh validation cases) unless the scene sets them."""
+        defaults of the slosh validation cases) unless the scene sets them; with
+        ``shear_stabilization`` (and ``element_height``) also the recommended shear stabilization
+        :func:`railslosh.fluids.default_shear_stabilization`."""
         rho = self.density()
         k = float(self.custom.get("bulk_penalty", fluids.default_bulk_penalty(rho, depth)))
         c = 0.0 if element_height is None else fluids.default_bulk_damping(k, rho, element_height)
         c = float(self.custom.get("bulk_damping", c))
+        gs = 0.0
+        if shear_stabilization and element_height is not None:
+            gs = fluids.default_shear_stabilization(rho, element_height)
         if self.oil == "custom":
             args = {key: v for key, v in self.custom.items() if key not in ("density", "model")}
-            args |= {"bulk_penalty": k, "bulk_damping": c}
+            args |= {"bulk_penalty": k, "bulk_damping": c, "shear_stabilization": gs}
             try:
                 return fluids.Fluid(rho, self.custom["model"], **args)
             except ValueError as exc:
                 raise scoped(exc, "fluid") from exc
         if self.oil == "water":
             _, mu, _ = fluids.LIQUIDS["water"]
-            return fluids.newtonian(rho, mu, bulk_penalty=k, bulk_damping=c)
+            return fluids.newtonian(rho, mu, bulk_penalty=k, bulk_damping=c, shear_stabilization=gs)
         _, mu, tau0 = fluids.CRUDE_OILS[self.oil]
-        return fluids.oldroyd(rho, mu, tau0, bulk_penalty=k, bulk_damping=c)
+        return fluids.oldroyd(rho, mu, tau0, bulk_penalty=k, bulk_damping=c, shear_stabilization=gs)
 
     def density(self) -> float:
         """Liquid density, kg/m^3."""

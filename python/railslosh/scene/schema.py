@@ -270,6 +270,9 @@ SCHEMA: dict[str, dict[str, dict[str, Field]]] = {
             "viscous_points": _int(3, 6, 3, "Gauss points per direction of the viscous stress"),
             "penalty_points": _int(2, 6, 3, "Gauss points per direction of the volumetric penalty"),
             "contact_points_per_edge": _int(2, 6, 3, "wall-contact points per boundary-face edge"),
+            "shear_stabilization": _flag(
+                False, "zero-energy-mode control that makes the rest state stable (docs/validation.md)"
+            ),
         },
         "solver": {
             "t_end": _num(0.0, 600.0, "s", "a time", 2.0, "simulated time", lo_open=True),

@@ -1,0 +1,150 @@
+//! Rest-state stability probe (issue 16 §6, docs/validation.md "A stable rest state"): settles a
+//! liquid at rest (viscosity 10⁴ Pa·s, `TS` s, default 3), then prints the smallest eigenvalues
+//! λ = ω² H/g of the linearization about that state and the frequencies of the modes with the
+//! largest longitudinal and lateral effective mass, for each shear stabilization given as a
+//! multiple β of ρ g H (−1: the recommended `default_shear_stabilization`).
+//!
+//! `cargo run --release -p rail-mbs --example rest_state -- KIND NV NP PPE NX NY NZ BETA...`
+//! with KIND `box` (seed 003 rectangular tank), `swri` (SwRI elliptic tank) or `car` (the tank
+//! car half full of light crude; `HEAD=0` for flat ends), NV/NP the viscous/penalty points per
+//! direction, PPE the contact points per face edge and NX NY NZ the element counts.
+//! `SHAPE=1` also prints the nodes that carry the three lowest modes.
+use ancf_core::FluidBody;
+use ancf_core::constants::GRAVITY as G;
+use ancf_core::constitutive::Rheology;
+use ancf_core::contact::{WallContact, WallContactLaw};
+use ancf_core::element::QuadratureOptions;
+use ancf_core::mesh::{CylinderTankSpec, EllipticCylinderSpec, box_mesh, cylinder_tank, elliptic_cylinder};
+use ancf_core::tank::{TankGeometry, TankShape};
+use rail_mbs::defaults::{Oil, liquid, slosh_params};
+use rail_mbs::slosh::{PrescribedMotion, SloshFrame, SloshRun, SloshSystem, linear_modes};
+use rail_mbs::vehicle::TankCarParams;
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let kind = args[0].clone();
+    let a: Vec<f64> = args[1..].iter().map(|s| s.parse().unwrap()).collect();
+    let (nv, np, ppe) = (a[0] as usize, a[1] as usize, a[2] as usize);
+    let c = [a[3] as usize, a[4] as usize, a[5] as usize];
+    let gs = &a[6..];
+    let (mesh, geo, depth, mut fluid) = match kind.as_str() {
+        "swri" => {
+            let spec = EllipticCylinderSpec::swri(c[0], c[1], c[2]);
+            let mesh = elliptic_cylinder(&spec).unwrap();
+            let depth = mesh.free_surface_z - mesh.nodes.iter().map(|n| n[2]).fold(f64::INFINITY, f64::min);
+            let geo = TankGeometry::new(
+                TankShape::EllipticCylinder {
+                    length: spec.length,
+                    semi_axis_y: spec.semi_axis_y,
+                    semi_axis_z: spec.semi_axis_z,
+                },
+                vec![],
+            )
+            .unwrap();
+            let fl = liquid(998.0, Rheology::Newtonian { viscosity: 1e-3 }, depth, depth / c[2] as f64).unwrap();
+            (mesh, geo, depth, fl)
+        }
+        "box" => {
+            let l = [0.416, 0.324, 0.132];
+            let lo = [-0.5 * l[0], -0.5 * l[1], 0.0];
+            let mesh = box_mesh(lo, l, c).unwrap();
+            let geo =
+                TankGeometry::new(TankShape::Box { min: lo, max: [0.5 * l[0], 0.5 * l[1], 0.3] }, vec![]).unwrap();
+            let fl = liquid(998.0, Rheology::Newtonian { viscosity: 1e-3 }, l[2], l[2] / c[2] as f64).unwrap();
+            (mesh, geo, l[2], fl)
+        }
+        _ => {
+            let p = TankCarParams::standard().unwrap();
+            let head: f64 = std::env::var("HEAD").map(|s| s.parse().unwrap()).unwrap_or(0.5);
+            let spec = CylinderTankSpec {
+                length: p.tank_length - 2.0 * head,
+                radius: p.tank_radius,
+                head_depth: head,
+                fill: 0.5,
+                n_length: c[0],
+                n_width: c[1],
+                n_height: c[2],
+                grading: 1.0,
+            };
+            let mesh = cylinder_tank(&spec).unwrap();
+            let geo = TankGeometry::new(
+                TankShape::Cylinder { length: spec.length, radius: spec.radius, head_depth: head },
+                vec![],
+            )
+            .unwrap();
+            let fl = Oil::Light.fluid(p.tank_radius, p.tank_radius / c[2] as f64).unwrap();
+            (mesh, geo, p.tank_radius, fl)
+        }
+    };
+    let rho = fluid.density;
+    let working = fluid.rheology;
+    fluid.rheology = Rheology::Newtonian { viscosity: 1e4 };
+    let body = FluidBody::new(mesh, fluid, QuadratureOptions { viscous: nv, penalty: np, mass: 4 }).unwrap();
+    let law = WallContactLaw { points_per_edge: ppe, ..WallContactLaw::default_for(rho, G, depth) };
+    let contact = WallContact::new(&body, geo, law).unwrap();
+    let sys =
+        SloshSystem::new(body, contact, PrescribedMotion::at_rest([0.0; 3]), [0.0, 0.0, -G], SloshFrame::Inertial)
+            .unwrap();
+    let mut run = SloshRun::new(sys, 0.0, slosh_params()).unwrap();
+    let ts: f64 = std::env::var("TS").map(|s| s.parse().unwrap()).unwrap_or(3.0);
+    run.run_to(ts, 0.02).unwrap();
+    let q = run.stepper.q().to_vec();
+    let run_v = run.stepper.v().to_vec();
+    let mut sys = run.stepper.into_system();
+    let rgh = rho * G * depth;
+    let g_default = sys.body.fluid.shear_stabilization;
+    {
+        use rail_mbs::integrator::MechanicalSystem;
+        let n = sys.n_coords();
+        let mut res = vec![0.0; n];
+        sys.forces(ts, &q, &vec![0.0; n], &mut res).unwrap();
+        let gn: f64 = sys.body.gravity_force([0.0, 0.0, -G]).iter().map(|x| x * x).sum::<f64>().sqrt();
+        let rn: f64 = res.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let vmax = run_v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        println!("settled: |Q|/|Q_g| = {:.2e}, max |v| = {vmax:.2e}", rn / gn);
+    }
+    for &g in gs {
+        sys.body.fluid.rheology = working;
+        // g < 0: the library default; else the multiple g of rho g H
+        sys.body.fluid.shear_stabilization = if g >= 0.0 { g * rgh } else { g_default };
+        let g = sys.body.fluid.shear_stabilization / rgh;
+        let modes = linear_modes(&mut sys, ts, &q).unwrap();
+        let lam: Vec<String> = modes.omega_sq.iter().take(4).map(|w| format!("{:.4}", w * depth / G)).collect();
+        let mut fl = [0.0; 2];
+        for (k, axis) in [0usize, 1].into_iter().enumerate() {
+            let d = modes.dominant(axis);
+            fl[k] = modes.omega_sq[d].max(0.0).sqrt() / (2.0 * std::f64::consts::PI);
+        }
+        if std::env::var("SHAPE").is_ok() {
+            for mode in 0..3 {
+                let col = modes.shapes.col(mode);
+                let n = col.nrows() / 12;
+                let mut amp: Vec<(f64, usize)> =
+                    (0..n).map(|k| ((0..3).map(|i| col[12 * k + i].powi(2)).sum::<f64>().sqrt(), k)).collect();
+                let tot_pos: f64 = amp.iter().map(|a| a.0 * a.0).sum();
+                let tot: f64 = (0..col.nrows()).map(|i| col[i] * col[i]).sum();
+                amp.sort_by(|a, b| b.0.total_cmp(&a.0));
+                print!("  mode {mode}: pos share {:.2}; top nodes", tot_pos / tot);
+                for &(v, k) in amp.iter().take(4) {
+                    print!(
+                        " #{k} ({:.2},{:.2},{:.2}) d=[{:.2},{:.2},{:.2}]/{v:.2}",
+                        q[12 * k],
+                        q[12 * k + 1],
+                        q[12 * k + 2],
+                        col[12 * k],
+                        col[12 * k + 1],
+                        col[12 * k + 2]
+                    );
+                }
+                println!();
+            }
+        }
+        println!(
+            "{kind} {nv}/{np}/{ppe} {c:?} beta {g} (G {:.2} Pa): lambda {} | f_x {:.4} Hz f_y {:.4} Hz",
+            g * rgh,
+            lam.join(" "),
+            fl[0],
+            fl[1]
+        );
+    }
+}
