@@ -7,7 +7,8 @@ import sys
 
 import pytest
 
-from railslosh import cli, validate
+import railslosh as rs
+from railslosh import cli, scene, validate
 
 
 def run_cli(*args):
@@ -123,7 +124,34 @@ def test_progress_bar_line_shows_time_eta_and_newton_statistics():
     eta = float(re.search(r"ETA\s+([0-9.]+) s", line).group(1))
     assert eta == pytest.approx(30.0, rel=0.01)  # 10 s for the first quarter: 30 s to go
     bar(10.0, 10.0, 400, 1800, 7)
-    assert bar.stream.getvalue().strip().startswith("[########################] 100.0%")
+    assert bar.stream.getvalue().strip().startswith("100.0% t = 10.000/10 s")
+
+
+def test_progress_true_shows_a_rich_bar_on_a_terminal_and_lines_elsewhere(capsys):
+    """Issue 19: API runs show progress with `progress=True` (a rich bar on a terminal, a plain
+    line per few seconds and at the end otherwise); the bar is closed when the run fails too."""
+    import io
+
+    from railslosh import progress
+
+    class Terminal(io.StringIO):
+        def isatty(self):
+            return True
+
+    bar = progress.ProgressBar(stream=Terminal(), description="demo run")
+    bar(5.0, 10.0, 100, 450, 2)
+    assert bar._bar is not None
+    bar(10.0, 10.0, 200, 900, 2)
+    assert bar._bar is None  # stopped at the end
+    drawn = bar.stream.getvalue()
+    assert "demo run" in drawn and "100.0%" in drawn and "Newton 4.50/step" in drawn
+    sc = scene.load_scene(EXAMPLES / "swri_lane_change_20mph.toml", {"solver": {"t_end": 0.05}})
+    args, kw = sc.run_args()
+    rs.slosh.run(*args, **{**kw, "progress": True})
+    err = capsys.readouterr().err
+    assert "100.0% t = 0.050/0.05 s" in err and "Newton" in err
+    with pytest.raises(ValueError, match="invalid `progress` = 'yes'"):
+        rs.slosh.run(*args, **{**kw, "progress": "yes"})
 
 
 def test_sweep_command_writes_one_dataset(tmp_path):
@@ -180,7 +208,10 @@ CLI_MISTAKES = [
     (["run", SWRI, "--set", "solver.t_end=-1"], "invalid `solver.t_end` = -1: expected a time > 0 s and ≤ 600 s"),
     (["run", SWRI, "--set", "solver.t_end=abc"], "invalid `solver.t_end` = 'abc': expected a time"),
     (["run", SWRI, "--set", "solver.tend=1"], "invalid `solver.tend`: unknown key (did you mean `solver.t_end`?)"),
-    (["run", SWRI, "--set", "outputs.vtu=true"], "invalid `outputs.vtu` = True: expected false: a slosh scene"),
+    (
+        ["run", SWRI, "--set", "outputs.snapshot_every=0.001"],
+        "invalid `outputs.snapshot_every` = 0.001: expected 0 (none) or an interval ≥ solver.step = 0.01 s",
+    ),
     (["run", SWRI, "--set", "fluid.fill=0.99"], "invalid `fluid.fill` = 0.99: expected a volume fraction from 0.03"),
     (["run", SWRI, "--set", "a.b.c=1"], "invalid `--set` = 'a.b.c': expected a field section.key"),
     (["run", SWRI, "--set", "solver"], "invalid `--set` = 'solver': expected section.key=VALUE"),

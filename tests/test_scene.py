@@ -371,7 +371,8 @@ BAD_NEW = [
     (SLOSH_BASE, "maneuver.offset", 50.0, "maneuver.offset"),
     (SLOSH_BASE, "maneuver.speed", 5.0, "maneuver.speed"),  # two speeds given
     (SLOSH_BASE, "track", {"preset": "tangent"}, "track"),
-    (SLOSH_BASE, "outputs.vtu", True, "outputs.vtu"),
+    (SLOSH_BASE, "outputs.vtu", "yes", "outputs.vtu"),
+    (SLOSH_BASE, "outputs.snapshot_every", 0.001, "outputs.snapshot_every"),  # finer than solver.step
     (SLOSH_BASE, "mesh.counts", [1, 2, 20], "mesh.counts[2]"),
 ]
 

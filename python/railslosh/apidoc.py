@@ -26,6 +26,7 @@ MODULES = (
     "railslosh.robustness",
     "railslosh.cosim",
     "railslosh.fmu",
+    "railslosh.progress",
     "railslosh.cli",
 )
 

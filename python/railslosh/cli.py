@@ -35,6 +35,7 @@ from railslosh import (
 )
 from railslosh._core import RailsloshError
 from railslosh.constants import GRAVITY
+from railslosh.progress import ProgressBar
 from railslosh.slosh import SimulationError
 
 _DESCRIPTION = """\
@@ -164,48 +165,6 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 # --- run / plot / report / sweep -------------------------------------------------------------------
 
 
-class ProgressBar:
-    """A one-line progress display on stderr: simulated time, wall time, ETA and Newton statistics.
-    Called as ``bar(t, t_end, steps, newton_iterations, rejected_steps)`` (the ``progress`` callback
-    of the run functions). On a terminal the line is redrawn; otherwise a line is printed at most
-    every ``every`` seconds."""
-
-    def __init__(self, stream: Any = None, width: int = 24, every: float = 5.0) -> None:
-        self.stream = stream if stream is not None else sys.stderr
-        self.width = width
-        self.every = every
-        self.start = time.perf_counter()
-        self.last_print = -math.inf
-        self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
-        self.calls = 0
-        self.last = ""
-
-    def line(self, t: float, t_end: float, steps: int, newton: int, rejected: int) -> str:
-        """The progress line: bar, percentage, simulated and wall time, ETA (wall time so far
-        scaled by the remaining fraction of simulated time), steps and Newton iterations per step."""
-        wall = time.perf_counter() - self.start
-        frac = min(max(t / t_end, 0.0), 1.0) if t_end > 0 else 1.0
-        eta = wall * (1.0 - frac) / frac if frac > 0 else math.inf
-        n = int(round(frac * self.width))
-        eta_s = f"{eta:6.1f} s" if math.isfinite(eta) else "     ? s"
-        return (
-            f"[{'#' * n}{'.' * (self.width - n)}] {100 * frac:5.1f}% t = {t:.3f}/{t_end:g} s | wall {wall:6.1f} s | "
-            f"ETA {eta_s} | {steps} steps ({rejected} rejected) | Newton {newton / max(steps, 1):.2f}/step"
-        )
-
-    def __call__(self, t: float, t_end: float, steps: int, newton: int, rejected: int) -> None:
-        self.calls += 1
-        self.last = self.line(t, t_end, steps, newton, rejected)
-        now = time.perf_counter()
-        done = t >= t_end * (1 - 1e-12)
-        if self.tty:
-            self.stream.write("\r" + self.last + ("\n" if done else ""))
-            self.stream.flush()
-        elif done or now - self.last_print >= self.every:
-            self.last_print = now
-            print(self.last, file=self.stream, flush=True)
-
-
 def _cmd_run(args: argparse.Namespace) -> int:
     over = scene.parse_overrides(args.set)
     doc = scene.read_scene(args.scene)
@@ -218,17 +177,21 @@ def _cmd_run(args: argparse.Namespace) -> int:
     if sc.kind != "slosh":
         choice = fluid_model.decide(sc)
         print(f"  fluid model: {choice.model} ({choice.reason})")
-    bar = None if args.quiet else ProgressBar()
+    bar = None if args.quiet else ProgressBar(description=sc.name or Path(args.scene).stem)
     status = 0
     t0 = time.perf_counter()
     try:
         res = scene.run_scene(sc, progress=bar)
     except SimulationError as exc:
+        if bar is not None:
+            bar.close()
         print(f"\nrailslosh run: {exc}", file=sys.stderr)
         res = dict(exc.results)
         res["scene"] = sc
         status = 1
     except KeyboardInterrupt:
+        if bar is not None:
+            bar.close()
         print("\nrailslosh run: interrupted", file=sys.stderr)
         return 130
     wall = time.perf_counter() - t0

@@ -16,12 +16,13 @@ from __future__ import annotations
 import os
 import re
 import warnings
-from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from railslosh import _core, limits
 from railslosh._core import Fluid, FluidMesh, RailsloshError
 from railslosh.constants import GRAVITY
+from railslosh.progress import ProgressArg
+from railslosh.progress import callback as progress_callback
 
 AXES = {"x": 0, "y": 1, "z": 2}
 
@@ -142,7 +143,7 @@ def run(
     h: float = 0.01,
     frame: str = "inertial",
     gravity: tuple[float, float, float] = (0.0, 0.0, -GRAVITY),
-    progress: Callable[[float, float, int, int, int], object] | None = None,
+    progress: ProgressArg = None,
     volume_tolerance: float = 0.01,
     penetration_limit: float = 0.5,
     contact_stiffness_factor: float = 1.0,
@@ -155,6 +156,7 @@ def run(
     contact_points_per_edge: int = 3,
     stepper: str = "implicit",
     wall_damping_ratio: float = _core.WALL_DAMPING_RATIO,
+    snapshot_every: float = 0.0,
 ) -> dict:
     """Integrate the fluid in the moving tank up to `t_end` with steps of at most `h`.
 
@@ -162,6 +164,7 @@ def run(
     pseudo-forces of seed 003 (appendix C, eq. 7.40). Returns a dict of numpy arrays
     (see ``railslosh._core.run_slosh``) and the integrator statistics under ``stats``.
     Raises :class:`SimulationError` (with ``.results``) if the run stops early.
+    ``progress=True`` shows a progress bar on stderr (:mod:`railslosh.progress`); a callable
     ``progress(t, t_end, steps, newton_iterations, rejected_steps)`` is called after the first step,
     then about every 0.5 s of wall time and at the end; if it raises, the run stops and the
     exception propagates.
@@ -205,6 +208,12 @@ def run(
     identical to the uninterrupted run's from there on (the first sample reports 0 Newton
     iterations). Together with ``stream`` this restarts long runs without losing or changing
     anything.
+
+    ``snapshot_every`` (s, 0 = none) keeps fluid mesh snapshots in the **tank frame**: the result's
+    ``snapshots`` is a list of ``(t, [nodes × 4 × 3])`` (positions and the three position gradients
+    of each node, the layout of :func:`railslosh.vehicle.run_fluid` with one car) and
+    ``connectivity`` the element-node table, which :func:`railslosh.results.write_vtu` writes for
+    ParaView.
     """
     wall_damping_ratio = limits.check("wall_damping_ratio", wall_damping_ratio)
     motion = motion or Motion()
@@ -212,33 +221,35 @@ def run(
     if unknown:
         raise ValueError(f"invalid parameter `motion.acceleration` axes {sorted(unknown)}: allowed x, y, z")
     acc = [motion.acceleration.get(a, []) for a in ("x", "y", "z")]
-    res = _core.run_slosh(
-        mesh,
-        fluid,
-        tank.shape,
-        list(tank.dims),
-        list(tank.bulkheads),
-        acc,
-        motion.rotation_axis,
-        motion.angular_acceleration,
-        t_end,
-        h,
-        frame,
-        list(gravity),
-        progress=progress,
-        volume_tolerance=volume_tolerance,
-        penetration_limit=penetration_limit,
-        contact_stiffness_factor=contact_stiffness_factor,
-        stream=None if stream is None else os.fspath(stream),
-        checkpoint=None if checkpoint is None else os.fspath(checkpoint),
-        checkpoint_every=checkpoint_every,
-        resume_from=None if resume_from is None else os.fspath(resume_from),
-        viscous_points=viscous_points,
-        penalty_points=penalty_points,
-        contact_points_per_edge=contact_points_per_edge,
-        stepper=stepper,
-        wall_damping_ratio=wall_damping_ratio,
-    )
+    with progress_callback(progress, "slosh run") as on_progress:
+        res = _core.run_slosh(
+            mesh,
+            fluid,
+            tank.shape,
+            list(tank.dims),
+            list(tank.bulkheads),
+            acc,
+            motion.rotation_axis,
+            motion.angular_acceleration,
+            t_end,
+            h,
+            frame,
+            list(gravity),
+            progress=on_progress,
+            volume_tolerance=volume_tolerance,
+            penetration_limit=penetration_limit,
+            contact_stiffness_factor=contact_stiffness_factor,
+            stream=None if stream is None else os.fspath(stream),
+            checkpoint=None if checkpoint is None else os.fspath(checkpoint),
+            checkpoint_every=checkpoint_every,
+            resume_from=None if resume_from is None else os.fspath(resume_from),
+            viscous_points=viscous_points,
+            penalty_points=penalty_points,
+            contact_points_per_edge=contact_points_per_edge,
+            stepper=stepper,
+            wall_damping_ratio=wall_damping_ratio,
+            snapshot_every=snapshot_every,
+        )
     res["wall_damping_ratio"] = wall_damping_ratio
     if res["error"] is not None:
         raise SimulationError(f"slosh run stopped at t = {res['t'][-1]:.4f} s: {res['error']}", res)

@@ -17,12 +17,14 @@ left; coupler forces are positive in tension.
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 
 from railslosh import _core, limits
+from railslosh.progress import ProgressArg
+from railslosh.progress import callback as progress_callback
 from railslosh.slosh import SimulationError
 
 WALL_DAMPING_RATIO: float = _core.WALL_DAMPING_RATIO
@@ -99,7 +101,7 @@ def run(
     coupler_stiffness: float | None = None,
     coupler_damping: float | None = None,
     car: dict[str, float] | None = None,
-    progress: Callable[[float, float, int, int, int], object] | None = None,
+    progress: ProgressArg = None,
     stream: str | os.PathLike[str] | None = None,
 ) -> dict[str, Any]:
     """Run ``cars`` coupled tank cars on ``track`` and return arrays of wheel loads ``Q``
@@ -109,6 +111,7 @@ def run(
     ``drive=True`` holds the front car to ``speed`` with the trajectory constraint (a number gives
     another speed); ``brake=(times, torques)`` applies that torque (N m) to every wheelset of the
     braked cars (``brake_scope`` ``"all"`` = ECP, ``"front"`` = front car only).
+    ``progress=True`` shows a progress bar on stderr (:mod:`railslosh.progress`); a callable
     ``progress(t, t_end, steps, newton_iterations, rejected_steps)`` is called after the first step,
     then about every 0.5 s of wall time and at the end; if it raises, the run stops and the
     exception propagates. ``stream`` (a file path) writes every recorded sample to that file as it
@@ -124,31 +127,32 @@ def run(
     ``.results`` up to the failure) when the run stops early.
     """
     drive_speed, times, torques = _drive_and_brake(drive, speed, brake)
-    res = dict(
-        _core.run_train(
-            _table(track),
-            cars=cars,
-            station=station,
-            speed=speed,
-            t_end=t_end,
-            step=step,
-            record_every=record_every,
-            load_filter=load_filter,
-            drive_speed=drive_speed,
-            brake_times=times,
-            brake_torques=torques,
-            brake_scope=brake_scope,
-            lading_mass=lading_mass,
-            lading_height=lading_height,
-            wheel_profile=wheel_profile,
-            wheelset_lateral_offset=wheelset_lateral_offset,
-            coupler_stiffness=coupler_stiffness,
-            coupler_damping=coupler_damping,
-            car=car,
-            progress=progress,
-            stream=None if stream is None else os.fspath(stream),
+    with progress_callback(progress, "vehicle run") as on_progress:
+        res = dict(
+            _core.run_train(
+                _table(track),
+                cars=cars,
+                station=station,
+                speed=speed,
+                t_end=t_end,
+                step=step,
+                record_every=record_every,
+                load_filter=load_filter,
+                drive_speed=drive_speed,
+                brake_times=times,
+                brake_torques=torques,
+                brake_scope=brake_scope,
+                lading_mass=lading_mass,
+                lading_height=lading_height,
+                wheel_profile=wheel_profile,
+                wheelset_lateral_offset=wheelset_lateral_offset,
+                coupler_stiffness=coupler_stiffness,
+                coupler_damping=coupler_damping,
+                car=car,
+                progress=on_progress,
+                stream=None if stream is None else os.fspath(stream),
+            )
         )
-    )
     res["load_filter"] = load_filter
     return _raise_on_error(res, "vehicle run")
 
@@ -184,7 +188,7 @@ def run_fluid(
     bulkheads: Sequence[tuple[float, float]] | None = None,
     wheel_profile: str = "s1002",
     car: dict[str, float] | None = None,
-    progress: Callable[[float, float, int, int, int], object] | None = None,
+    progress: ProgressArg = None,
     stream: str | os.PathLike[str] | None = None,
     wall_damping_ratio: float = WALL_DAMPING_RATIO,
 ) -> dict[str, Any]:
@@ -207,34 +211,35 @@ def run_fluid(
     fill = limits.check("fill", fill)
     wall_damping_ratio = limits.check("wall_damping_ratio", wall_damping_ratio)
     drive_speed, times, torques = _drive_and_brake(drive, speed, brake)
-    res = dict(
-        _core.run_fluid_train(
-            _table(track),
-            cars=cars,
-            station=station,
-            speed=speed,
-            t_end=t_end,
-            step=step,
-            record_every=record_every,
-            load_filter=load_filter,
-            snapshot_every=snapshot_every,
-            drive_speed=drive_speed,
-            brake_times=times,
-            brake_torques=torques,
-            brake_scope=brake_scope,
-            brake_factors=None if brake_factors is None else list(map(float, brake_factors)),
-            oil=oil,
-            fluid=fluid,
-            counts=tuple(counts),
-            fill=fill,
-            bulkheads=None if bulkheads is None else [(float(x), float(t)) for x, t in bulkheads],
-            wheel_profile=wheel_profile,
-            car=car,
-            progress=progress,
-            stream=None if stream is None else os.fspath(stream),
-            wall_damping_ratio=wall_damping_ratio,
+    with progress_callback(progress, "vehicle run") as on_progress:
+        res = dict(
+            _core.run_fluid_train(
+                _table(track),
+                cars=cars,
+                station=station,
+                speed=speed,
+                t_end=t_end,
+                step=step,
+                record_every=record_every,
+                load_filter=load_filter,
+                snapshot_every=snapshot_every,
+                drive_speed=drive_speed,
+                brake_times=times,
+                brake_torques=torques,
+                brake_scope=brake_scope,
+                brake_factors=None if brake_factors is None else list(map(float, brake_factors)),
+                oil=oil,
+                fluid=fluid,
+                counts=tuple(counts),
+                fill=fill,
+                bulkheads=None if bulkheads is None else [(float(x), float(t)) for x, t in bulkheads],
+                wheel_profile=wheel_profile,
+                car=car,
+                progress=on_progress,
+                stream=None if stream is None else os.fspath(stream),
+                wall_damping_ratio=wall_damping_ratio,
+            )
         )
-    )
     res["load_filter"] = load_filter
     res["wall_damping_ratio"] = wall_damping_ratio
     return _raise_on_error(res, "fluid vehicle run")
@@ -294,7 +299,7 @@ def run_equivalent(
     lading_height: float = 0.0,
     wheel_profile: str = "s1002",
     car: dict[str, float] | None = None,
-    progress: Callable[[float, float, int, int, int], object] | None = None,
+    progress: ProgressArg = None,
     stream: str | os.PathLike[str] | None = None,
 ) -> dict[str, Any]:
     """Run tank cars whose liquid is its equivalent mechanical model: per compartment one slosh mass
@@ -309,34 +314,35 @@ def run_equivalent(
         raise ValueError(f"invalid parameter `slosh_axis` = {slosh_axis!r}: allowed one of {', '.join(SLOSH_AXES)}")
     fill = limits.check("fill", fill)
     drive_speed, times, torques = _drive_and_brake(drive, speed, brake)
-    res = dict(
-        _core.run_equivalent_train(
-            _table(track),
-            cars=cars,
-            station=station,
-            speed=speed,
-            t_end=t_end,
-            step=step,
-            record_every=record_every,
-            load_filter=load_filter,
-            drive_speed=drive_speed,
-            brake_times=times,
-            brake_torques=torques,
-            brake_scope=brake_scope,
-            brake_factors=None if brake_factors is None else list(map(float, brake_factors)),
-            oil=oil,
-            fluid=fluid,
-            fill=fill,
-            bulkheads=None if bulkheads is None else [(float(x), float(t)) for x, t in bulkheads],
-            slosh_axis=slosh_axis,
-            lading_mass=lading_mass,
-            lading_height=lading_height,
-            wheel_profile=wheel_profile,
-            car=car,
-            progress=progress,
-            stream=None if stream is None else os.fspath(stream),
+    with progress_callback(progress, "vehicle run") as on_progress:
+        res = dict(
+            _core.run_equivalent_train(
+                _table(track),
+                cars=cars,
+                station=station,
+                speed=speed,
+                t_end=t_end,
+                step=step,
+                record_every=record_every,
+                load_filter=load_filter,
+                drive_speed=drive_speed,
+                brake_times=times,
+                brake_torques=torques,
+                brake_scope=brake_scope,
+                brake_factors=None if brake_factors is None else list(map(float, brake_factors)),
+                oil=oil,
+                fluid=fluid,
+                fill=fill,
+                bulkheads=None if bulkheads is None else [(float(x), float(t)) for x, t in bulkheads],
+                slosh_axis=slosh_axis,
+                lading_mass=lading_mass,
+                lading_height=lading_height,
+                wheel_profile=wheel_profile,
+                car=car,
+                progress=on_progress,
+                stream=None if stream is None else os.fspath(stream),
+            )
         )
-    )
     res["load_filter"] = load_filter
     return _raise_on_error(res, "equivalent-slosh vehicle run")
 

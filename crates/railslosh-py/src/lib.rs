@@ -499,7 +499,7 @@ impl PyFluidBody {
                     progress=None, volume_tolerance=0.01, penetration_limit=0.5, contact_stiffness_factor=1.0,
                     stream=None, checkpoint=None, checkpoint_every=100, resume_from=None,
                     contact_points_per_edge=3, contact_point_rule="gauss", stepper="implicit",
-                    wall_damping_ratio=ancf_core::contact::WALL_DAMPING_RATIO))]
+                    wall_damping_ratio=ancf_core::contact::WALL_DAMPING_RATIO, snapshot_every=0.0))]
 #[allow(clippy::too_many_arguments)]
 fn run_slosh<'py>(
     py: Python<'py>,
@@ -529,6 +529,7 @@ fn run_slosh<'py>(
     contact_point_rule: &str,
     stepper: &str,
     wall_damping_ratio: f64,
+    snapshot_every: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
     use ancf_core::contact::{ContactPointRule, WallContact, WallContactLaw};
     use ancf_core::tank::{Bulkhead, TankGeometry, TankShape};
@@ -575,7 +576,11 @@ fn run_slosh<'py>(
     if !(contact_stiffness_factor.is_finite() && contact_stiffness_factor > 0.0) {
         return Err(bad("contact_stiffness_factor", contact_stiffness_factor.to_string(), "a finite number > 0"));
     }
+    if !(snapshot_every.is_finite() && snapshot_every >= 0.0) {
+        return Err(bad("snapshot_every", snapshot_every.to_string(), "a finite interval >= 0 s (0: no snapshots)"));
+    }
     let (m, f) = (mesh.inner.clone(), fluid.inner);
+    let connectivity: Vec<i64> = m.elements.iter().flatten().map(|&n| n as i64).collect();
     let mut observer = PyProgress::new(progress);
     let obs = &mut observer;
     let result = compute(py, move || {
@@ -645,6 +650,7 @@ fn run_slosh<'py>(
                 run
             }
         };
+        run.set_snapshot_every(snapshot_every).map_err(|e| AncfError::NonFinite { what: e.to_string(), element: 0 })?;
         if let Some(path) = &checkpoint {
             if checkpoint_every == 0 {
                 return Err(ancf_core::error::invalid("checkpoint_every", 0, ">= 1 (steps)"));
@@ -668,10 +674,10 @@ fn run_slosh<'py>(
         let s = *run.stats();
         let margins = run.margins();
         let used = run.stepper.name();
-        Ok((run.record, err, s, margins, used, reason))
+        Ok((run.record, err, s, margins, used, reason, run.snapshots))
     })?;
     observer.finish()?;
-    let (rec, err, stats, margins, used, reason) = result;
+    let (rec, err, stats, margins, used, reason, snapshots) = result;
     let d = PyDict::new(py);
     let v3 = |x: &Vec<[f64; 3]>| -> PyResult<Bound<'py, PyAny>> {
         let n = x.len();
@@ -694,6 +700,15 @@ fn run_slosh<'py>(
     d.set_item("min_volume_ratio", PyArray1::from_vec(py, rec.min_volume_ratio))?;
     d.set_item("containment_gap", PyArray1::from_vec(py, rec.containment_gap))?;
     d.set_item("margins", margins_dict(py, &margins)?)?;
+    // the vehicle runs' snapshot layout, with one "car": (t, [nodes × 4 × 3]), tank frame
+    let snaps = pyo3::types::PyList::empty(py);
+    for (t, e) in snapshots {
+        let n = e.len() / 12;
+        snaps.append((t, vec![PyArray1::from_vec(py, e).reshape([n, 4, 3])?]))?;
+    }
+    d.set_item("snapshots", snaps)?;
+    let ne = connectivity.len() / 8;
+    d.set_item("connectivity", PyArray1::from_vec(py, connectivity).reshape([ne, 8])?)?;
     d.set_item("stepper", used)?;
     d.set_item("stepper_reason", reason)?;
     d.set_item("error", err)?;

@@ -36,6 +36,13 @@ def meta(kind: str, doc: Mapping[str, Any]) -> tuple[str, str]:
     return sec.get("name"), sec.get("description")
 
 
+def settle_time(kind: str, doc: Mapping[str, Any]) -> float | None:
+    """``[scene] settle_time``: the declared settling phase, s (``None``: detected from the results,
+    :func:`railslosh.results.settling`)."""
+    value = Section(kind, "scene", doc).get("settle_time")
+    return None if value is None else float(value)
+
+
 def vehicle_outputs(doc: Mapping[str, Any], has_snapshots: bool, record_every: float) -> Outputs:
     """``[outputs]`` of a vehicle scene; snapshots need liquid cargo and are no finer than the
     recording."""
@@ -51,12 +58,12 @@ def vehicle_outputs(doc: Mapping[str, Any], has_snapshots: bool, record_every: f
     return Outputs(snapshot_every=snap, **flags)
 
 
-def slosh_outputs(doc: Mapping[str, Any]) -> Outputs:
-    """``[outputs]`` of a slosh scene: results and plots; fluid snapshots come from vehicle scenes."""
-    sec = Section("slosh", "outputs", doc, extra=("snapshot_every",))
-    why = "a slosh scene writes no fluid snapshots (they come from vehicle scenes)"
-    if "vtu" in sec and sec.values["vtu"] is not False:
-        raise invalid("outputs.vtu", sec.values["vtu"], f"false: {why}")
-    if "snapshot_every" in sec:
-        raise invalid("outputs.snapshot_every", sec.values["snapshot_every"], f"no snapshot interval: {why}")
-    return Outputs(netcdf=sec.get("netcdf"), plots=sec.get("plots"), vtu=False)
+def slosh_outputs(doc: Mapping[str, Any], step: float) -> Outputs:
+    """``[outputs]`` of a slosh scene: results, plots and fluid snapshots (in the tank frame), no
+    finer than the solver's largest step."""
+    sec = Section("slosh", "outputs", doc)
+    flags = {k: sec.get(k) for k in ("netcdf", "vtu", "plots")}
+    snap = sec.get("snapshot_every")
+    if 0.0 < snap < step:
+        raise invalid("outputs.snapshot_every", snap, f"0 (none) or an interval ≥ solver.step = {step:g} s")
+    return Outputs(snapshot_every=snap, **flags)

@@ -113,6 +113,9 @@ def _value(value: str, doc: str, default: Any = None, default_doc: str = "") -> 
 _META = {
     "name": Field("text", "title of the scene", ""),
     "description": Field("text", "what the scene is for", ""),
+    "settle_time": _num(
+        0.0, 600.0, "s", "a time", None, "settling phase that peaks and the report leave out (default: detected)"
+    ),
 }
 _CUSTOM = {
     "model": _choice(RHEOLOGIES, None, 'rheology of a custom oil (only with oil = "custom", required there)'),
@@ -283,8 +286,9 @@ SCHEMA: dict[str, dict[str, dict[str, Field]]] = {
         },
         "outputs": {
             "netcdf": _flag(True, "write results.nc"),
+            "vtu": _flag(True, "write fluid/*.vtu and fluid.pvd, tank frame (needs snapshot_every)"),
             "plots": _flag(True, "write PNG plots"),
-            "vtu": _value("false", "fluid snapshots come from vehicle scenes only", False),
+            "snapshot_every": _num(0.0, 600.0, "s", "an interval", 0.0, "fluid mesh snapshots (0 = none)"),
         },
         "maneuver": {
             "type": _choice(MANEUVERS, None, "the prescribed motion (required)"),

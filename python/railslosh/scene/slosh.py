@@ -12,7 +12,7 @@ import numpy as np
 
 from railslosh import fluids
 from railslosh.constants import GRAVITY
-from railslosh.scene.common import Outputs, meta, slosh_outputs
+from railslosh.scene.common import Outputs, meta, settle_time, slosh_outputs
 from railslosh.scene.fluid import FluidSpec, oil_and_custom
 from railslosh.scene.maneuvers import maneuver, motion
 from railslosh.scene.schema import Section, counts, merge, scoped, table, unknown_sections
@@ -90,7 +90,10 @@ class SloshScene:
     """``"implicit"``, ``"explicit"`` or ``"auto"`` (:func:`railslosh.slosh.run`)."""
     name: str = ""
     description: str = ""
-    outputs: Outputs = field(default_factory=lambda: Outputs(vtu=False))
+    settle_time: float | None = None
+    """``[scene] settle_time``: the settling phase that peaks, statistics and the report leave out, s
+    (``None``: detected from the results, :func:`railslosh.results.settling`)."""
+    outputs: Outputs = field(default_factory=Outputs)
     raw: Mapping[str, Any] = field(default_factory=dict, compare=False, repr=False)
 
     kind = "slosh"
@@ -140,6 +143,8 @@ class SloshScene:
             "contact_points_per_edge": self.contact_points_per_edge,
             "stepper": self.stepper,
         }
+        if self.outputs.snapshot_every > 0:
+            kw["snapshot_every"] = self.outputs.snapshot_every
         if self.contact_stiffness_factor != 1.0:
             kw["contact_stiffness_factor"] = self.contact_stiffness_factor
         if self.fluid.wall_damping_ratio != WALL_DAMPING_RATIO:
@@ -156,6 +161,7 @@ def slosh_scene_from_dict(data: Mapping[str, Any]) -> SloshScene:
     data = table(data, "scene")
     unknown_sections(data, "slosh")
     name, description = meta("slosh", data)
+    settle = settle_time("slosh", data)
     sv = Section("slosh", "solver", data)
     stepper = sv.get("stepper")
     wall = sv.get("contact_stiffness_factor")
@@ -175,7 +181,7 @@ def slosh_scene_from_dict(data: Mapping[str, Any]) -> SloshScene:
     tank = slosh_tank(tk, n)
     spec = FluidSpec(oil=oil, fill=fill, counts=n, bulkheads=tank.bulkheads, custom=custom, wall_damping_ratio=zeta)
     man = maneuver(data, t_end)
-    outputs = slosh_outputs(data)
+    outputs = slosh_outputs(data, step)
     sc = SloshScene(
         tank=tank,
         fluid=spec,
@@ -187,6 +193,7 @@ def slosh_scene_from_dict(data: Mapping[str, Any]) -> SloshScene:
         stepper=stepper,
         name=name,
         description=description,
+        settle_time=settle,
         outputs=outputs,
         raw=dict(data),
         **rules,

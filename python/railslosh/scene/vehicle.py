@@ -14,7 +14,7 @@ import numpy as np
 
 from railslosh import rail, vehicle
 from railslosh.limits import Limit, invalid, missing
-from railslosh.scene.common import Outputs, meta, vehicle_outputs
+from railslosh.scene.common import Outputs, meta, settle_time, vehicle_outputs
 from railslosh.scene.fluid import FluidSpec, vehicle_fluid
 from railslosh.scene.schema import Section, increasing, number_list, scoped, table, unknown_sections
 from railslosh.scene.track import track
@@ -74,6 +74,9 @@ class Scene:
     name: str = ""
     """Title of the scene (``[scene] name``)."""
     description: str = ""
+    settle_time: float | None = None
+    """``[scene] settle_time``: the settling phase that peaks, statistics and the report leave out, s
+    (``None``: detected from the results, :func:`railslosh.results.settling`)."""
     fluid: FluidSpec | None = None
     """Liquid cargo (``[fluid]``, ``[mesh]``, ``[tank]``); ``None`` = rigid lading only."""
     brake_factors: tuple[float, ...] | None = None
@@ -310,6 +313,7 @@ def scene_from_dict(data: Mapping[str, Any]) -> Scene:
     br = _brake(data, tr["speed"], tr["cars"])
     lading_mass, lading_height = _lading(data, params["tank_radius"])
     name, description = meta("vehicle", data)
+    settle = settle_time("vehicle", data)
     fluid = None
     if "fluid" in data:
         fluid = vehicle_fluid(data, params)
@@ -352,6 +356,7 @@ def scene_from_dict(data: Mapping[str, Any]) -> Scene:
         wheel_profile=wheel_profile,
         name=name,
         description=description,
+        settle_time=settle,
         fluid=fluid,
         brake_factors=br["factors"],
         brake_design=br["design"],

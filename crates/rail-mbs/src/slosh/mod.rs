@@ -254,6 +254,13 @@ pub struct SloshRun {
     /// The run-time invariants, checked on every accepted step (issue 16). A resumed
     /// run starts its energy account at the checkpoint.
     pub invariants: InvariantMonitor,
+    /// Fluid snapshots (issue 19): time and the nodal coordinates in the **tank frame** (12
+    /// per node: position and the three position gradients), taken every
+    /// [`SloshRun::set_snapshot_every`] seconds at the first recorded step on or after each
+    /// multiple; a violating state is recorded before the run stops, so it is in here too.
+    pub snapshots: Vec<(f64, Vec<f64>)>,
+    snapshot_every: f64,
+    next_snapshot: f64,
 }
 
 /// A failed run: the error and everything recorded up to it.
@@ -322,9 +329,62 @@ impl SloshRun {
 
     fn with_stepper(stepper: SloshStepper) -> Result<Self, IntegratorError> {
         let invariants = stepper.system().invariant_monitor();
-        let mut run = Self { stepper, record: SloshRecord::default(), checkpoints: None, invariants };
+        let mut run = Self {
+            stepper,
+            record: SloshRecord::default(),
+            checkpoints: None,
+            invariants,
+            snapshots: Vec::new(),
+            snapshot_every: 0.0,
+            next_snapshot: f64::INFINITY,
+        };
         run.record_state(0)?;
         Ok(run)
+    }
+
+    /// Takes a fluid snapshot now and then every `every` s of simulated time (0: none, the
+    /// default); earlier snapshots are dropped.
+    pub fn set_snapshot_every(&mut self, every: f64) -> Result<(), IntegratorError> {
+        if !(every.is_finite() && every >= 0.0) {
+            return Err(IntegratorError::InvalidParameter {
+                field: "snapshot_every",
+                value: every,
+                allowed: "a finite interval >= 0 s",
+            });
+        }
+        self.snapshots.clear();
+        self.snapshot_every = every;
+        self.next_snapshot = if every > 0.0 { self.stepper.t() } else { f64::INFINITY };
+        self.take_snapshot();
+        Ok(())
+    }
+
+    /// The current state's nodal coordinates in the tank frame, if a snapshot is due.
+    fn take_snapshot(&mut self) {
+        let t = self.stepper.t();
+        if self.snapshot_every <= 0.0 || t < self.next_snapshot - 1e-9 * self.snapshot_every {
+            return;
+        }
+        while self.next_snapshot <= t + 1e-9 * self.snapshot_every {
+            self.next_snapshot += self.snapshot_every;
+        }
+        let sys = self.stepper.system();
+        let q = self.stepper.q();
+        let e = match sys.frame {
+            SloshFrame::Tank => q.to_vec(),
+            SloshFrame::Inertial => {
+                let k = sys.motion.state(t).kinematics;
+                let (at, r) = (k.rotation.transpose(), Vector3::from(k.position));
+                let mut e = vec![0.0; q.len()];
+                for (s, (out, x)) in e.chunks_exact_mut(3).zip(q.chunks_exact(3)).enumerate() {
+                    let x = Vector3::new(x[0], x[1], x[2]);
+                    let y = if s % 4 == 0 { at * (x - r) } else { at * x };
+                    out.copy_from_slice(y.as_slice());
+                }
+                e
+            }
+        };
+        self.snapshots.push((t, e));
     }
 
     /// Resume from a checkpoint of an earlier run of the same system (same mesh, fluid,
@@ -513,6 +573,8 @@ impl SloshRun {
         let margins = self.invariants.margins();
         r.min_volume_ratio.push(m.map_or(margins.min_volume_ratio, |m| m.min_volume_ratio));
         r.containment_gap.push(m.map_or(margins.worst_gap, |m| m.gap));
-        checked.map(|_| ()).map_err(|source| IntegratorError::System { t, source })
+        let checked = checked.map(|_| ());
+        self.take_snapshot();
+        checked.map_err(|source| IntegratorError::System { t, source })
     }
 }
