@@ -14,7 +14,7 @@ from railslosh.cli import main
 
 def test_sweep_names_and_bad_case():
     assert bench.cases() == ["slosh-tank", "ecp-braking", "ecp-braking-spread"]
-    with pytest.raises(ValueError, match="invalid parameter `case`"):
+    with pytest.raises(ValueError, match="invalid `case`"):
         bench.run(["nope"])
 
 

@@ -127,13 +127,13 @@ def test_a_rigid_scene_carries_the_liquid_as_lading():
 
 def test_run_equivalent_rejects_bad_parameters_by_name():
     track = [[0, 0, 0, 0, 0, 0], [500, 0, 0, 0, 0, 0]]
-    with pytest.raises(ValueError, match="invalid parameter `slosh_axis`"):
+    with pytest.raises(ValueError, match="invalid `slosh_axis`"):
         vehicle.run_equivalent(track, slosh_axis="vertical")
     with pytest.raises(ValueError, match="invalid `fill`"):
         vehicle.run_equivalent(track, fill=1.5)
-    with pytest.raises(ValueError, match="invalid parameter `bulkheads"):
+    with pytest.raises(ValueError, match="invalid `bulkheads"):
         vehicle.equivalent_model(0.5, bulkheads=[(9.0, 0.02)])
-    with pytest.raises(ValueError, match="invalid parameter `depth fraction"):
+    with pytest.raises(ValueError, match="invalid `depth fraction"):
         _core.equivalent_lambda(0.99)
 
 

@@ -142,5 +142,5 @@ def test_figures_are_drawn_in_the_package_style(rigid, tmp_path):
         "wheelset_lateral",
         "speed",
     }
-    with pytest.raises(ValueError, match="invalid parameter `stem`"):
+    with pytest.raises(ValueError, match="invalid `stem`"):
         plots.figure(rigid, "nope")

@@ -148,7 +148,7 @@ def test_report_summary_excludes_the_settling_phase_of_a_synthetic_run(tmp_path)
 
 
 def test_report_of_a_directory_without_results_is_a_clear_error(tmp_path):
-    with pytest.raises(ValueError, match=r"invalid parameter `results_dir`.*results.nc"):
+    with pytest.raises(ValueError, match=r"invalid `results_dir`.*results.nc"):
         report.write_report(tmp_path)
 
 

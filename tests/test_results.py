@@ -124,7 +124,7 @@ def test_vtu_snapshots_and_pvd_collection(fluid_run, tmp_path):
         assert vols.sum() == pytest.approx(fluid_run["fluid_mass"] / rho, rel=0.08)
         assert set(m.point_data) == {"displacement", "r_x", "r_y", "r_z"}
     assert results.write_vtu({"snapshots": []}, tmp_path, fluid_run["connectivity"]) is None
-    with pytest.raises(ValueError, match="invalid parameter `connectivity`"):
+    with pytest.raises(ValueError, match="invalid `connectivity`"):
         results.write_vtu(fluid_run, tmp_path, np.zeros((2, 4), dtype=int))
 
 
@@ -262,7 +262,7 @@ def test_extreme_finds_largest_smallest_and_largest_magnitude():
     assert lo.value == pytest.approx(-3.0) and lo.where == {"coupler": 2} and lo.time == 1.0
     assert hi.value == pytest.approx(np.sin(2 * np.pi * 0.2)) and hi.time == pytest.approx(0.2)
     assert results.extreme(da, after=0.55).time == pytest.approx(1.0)
-    with pytest.raises(ValueError, match="invalid parameter `mode`"):
+    with pytest.raises(ValueError, match="invalid `mode`"):
         results.extreme(da, mode="mean")
 
 

@@ -8,6 +8,7 @@ from railslosh import scene, sweep
 
 ROOT = __import__("pathlib").Path(__file__).resolve().parents[1]
 RIGID = ROOT / "examples/scenes/two_car_ecp_braking_rigid.toml"
+SWRI = ROOT / "examples/scenes/swri_lane_change_20mph.toml"
 
 
 def test_parse_grid_reads_toml_values():
@@ -67,3 +68,22 @@ def test_tiny_sweep_on_a_local_cluster_equals_the_direct_runs():
                 ds["coupler_force"].sel(speed=v, braking=b).values, res["coupler_force"], rtol=1e-9, atol=1e-9
             )
             np.testing.assert_allclose(ds["tank_speed"].sel(speed=v, braking=b).values, res["tank_speed"], rtol=1e-12)
+
+
+def test_a_slosh_point_is_resampled_with_the_vehicle_load_filter():
+    """Issue 19: a slosh run records every adaptive step; the sweep puts it on multiples of
+    solver.step with its loads as hat-weighted means (the filter vehicle runs record loads with),
+    says so, and keeps the other channels interpolated."""
+    from railslosh import _core, results
+
+    base = scene.read_scene(SWRI)
+    over = {"solver": {"t_end": 0.3}}
+    ds = sweep.run_point(base, over)
+    assert "hat-weighted mean" in ds.attrs["resampling"] and "force_tank" in ds.attrs["resampling"]
+    t = ds["time"].values
+    np.testing.assert_allclose(np.diff(t), 0.01, atol=1e-12)
+    sc = scene.load_scene(base, over)
+    raw = results.to_dataset(scene.run_scene(sc), sc)
+    expected = _core.hat_mean_resample(list(raw["time"].values), raw["force_tank"].values.tolist(), 0.01)
+    np.testing.assert_allclose(ds["force_tank"].values, expected[: len(t)], rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(ds["com_tank"].values, raw["com_tank"].interp(time=t).values, rtol=1e-12)

@@ -1,7 +1,7 @@
 """Type stubs of the Rust extension module ``railslosh._core``."""
 
 import os
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any, final
 
 import numpy as np
@@ -385,6 +385,7 @@ def equivalent_model(
     slosh_axis: str = "longitudinal",
     car: dict[str, float] | None = None,
 ) -> dict[str, Any]: ...
+def hat_mean_resample(t: Sequence[float], values: Sequence[Sequence[float]], dt: float) -> npt.NDArray[np.float64]: ...
 def equivalent_lambda(depth_fraction: float) -> float: ...
 
 # --- co-simulation: the slosh participant (rail_mbs::cosim, issue 6) ---

@@ -41,7 +41,7 @@ def run(names: list[str] | None = None, *, quick: bool = False) -> list[Point]:
     names = list(names or cases())
     unknown = [n for n in names if n not in cases()]
     if unknown:
-        raise ValueError(f"invalid parameter `case` = {unknown}: allowed {cases()}")
+        raise ValueError(f"invalid `case` = {unknown}: expected {cases()}")
     points: list[Point] = []
     for n in names:
         points.extend(_core.run_work_precision(n, quick))

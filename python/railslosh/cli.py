@@ -548,10 +548,10 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     except (ValueError, OSError) as exc:  # bad input: a field, a path, a file that is not what it should be
         msg = str(exc) if not isinstance(exc, OSError) or str(exc).startswith("invalid `") else _os_error(exc)
-        print(f"{where}: {limits.reword(msg)}", file=sys.stderr)
+        print(f"{where}: {msg}", file=sys.stderr)
         return 2
     except RailsloshError as exc:  # a computation the kernels could not do
-        print(f"{where}: {limits.reword(str(exc))}", file=sys.stderr)
+        print(f"{where}: {exc}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
         print(f"\n{where}: interrupted", file=sys.stderr)

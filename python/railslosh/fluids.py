@@ -31,9 +31,7 @@ def default_bulk_penalty(density: float, depth: float, strain: float = 1e-3) -> 
     The rule is ``rail_mbs::defaults::default_bulk_penalty``, the one vehicle runs use.
     """
     if not (density > 0 and depth > 0 and strain > 0):
-        raise ValueError(
-            f"invalid parameter `density`/`depth`/`strain` = {density}/{depth}/{strain}: allowed numbers > 0"
-        )
+        raise ValueError(f"invalid `density`/`depth`/`strain` = {density}/{depth}/{strain}: expected numbers > 0")
     return _core.default_bulk_penalty(density, depth, strain)
 
 
@@ -178,7 +176,7 @@ def casson(
 def crude_oil(kind: str, *, depth: float = 1.5, bulk_penalty: float | None = None) -> Fluid:
     """Light, medium or heavy crude of seed 000 Table 2, with the Oldroyd model as in the paper."""
     if kind not in CRUDE_OILS:
-        raise ValueError(f"invalid parameter `kind` = {kind!r}: allowed one of {sorted(CRUDE_OILS)}")
+        raise ValueError(f"invalid `kind` = {kind!r}: expected one of {sorted(CRUDE_OILS)}")
     rho, mu, tau0 = CRUDE_OILS[kind]
     return oldroyd(rho, mu, tau0, depth=depth, bulk_penalty=bulk_penalty)
 

@@ -59,7 +59,7 @@ def find_fmu(build: bool = True, debug: bool = False) -> Path:
     if env:
         p = Path(env)
         if not p.is_file():
-            raise ValueError(f"invalid parameter `RAILSLOSH_FMU` = {env!r}: allowed the path of an existing .fmu file")
+            raise ValueError(f"invalid `RAILSLOSH_FMU` = {env!r}: expected the path of an existing .fmu file")
         return p
     root = source_root()
     if root is None:
@@ -84,17 +84,17 @@ def tank_motion(t, **columns) -> np.ndarray:
     at their defaults (zero; ``gravity_z`` = -g0)."""
     t = np.asarray(t, dtype=float)
     if t.ndim != 1 or t.size < 1 or np.any(np.diff(t) < 0) or not np.all(np.isfinite(t)):
-        raise ValueError("invalid parameter `t`: allowed a non-decreasing 1-D array of finite times")
+        raise ValueError("invalid `t`: expected a non-decreasing 1-D array of finite times")
     unknown = sorted(set(columns) - set(INPUTS))
     if unknown:
-        raise ValueError(f"invalid parameter `{unknown[0]}`: allowed inputs {', '.join(INPUTS)}")
+        raise ValueError(f"invalid `{unknown[0]}`: expected inputs {', '.join(INPUTS)}")
     sig = np.zeros(t.size, dtype=[("time", float)] + [(k, float) for k in INPUTS])
     sig["time"] = t
     sig["gravity_z"] = -GRAVITY
     for k, v in columns.items():
         v = np.broadcast_to(np.asarray(v, dtype=float), t.shape)
         if not np.all(np.isfinite(v)):
-            raise ValueError(f"invalid parameter `{k}`: allowed finite values")
+            raise ValueError(f"invalid `{k}`: expected finite values")
         sig[k] = v
     return sig
 

@@ -16,7 +16,7 @@ def read_journal(path: str | os.PathLike[str], what: str = "results stream") -> 
     with open(path, "rb") as f:
         data = f.read()
     if data[:8] != MAGIC or len(data) < 12:
-        raise ValueError(f"invalid parameter `path` = {os.fspath(path)!r}: allowed a {what} file")
+        raise ValueError(f"invalid `path` = {os.fspath(path)!r}: expected a {what} file")
     ncol = int.from_bytes(data[8:12], "little")
     pos, names = 12, []
     for _ in range(ncol):

@@ -10,9 +10,7 @@ error: ``invalid `dotted.field` = value: expected …``.
 
 :data:`PARAMETERS` is the table of the limits that scenes (:mod:`railslosh.scene`) and the API
 functions taking the same parameter (:func:`railslosh.mesh.cylinder_tank`,
-:func:`railslosh.vehicle.run_fluid`, ...) both check. Messages raised by the compiled kernels
-(``invalid parameter `x` = v: allowed …``) are put into the same form by :func:`reword` wherever
-they reach a scene or the command line.
+:func:`railslosh.vehicle.run_fluid`, ...) both check. The compiled kernels raise their errors in the same form.
 """
 
 from __future__ import annotations
@@ -20,12 +18,11 @@ from __future__ import annotations
 import difflib
 import math
 import numbers
-import re
 from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["FILL", "PARAMETERS", "Limit", "check", "invalid", "missing", "reword", "suggest", "unknown"]
+__all__ = ["FILL", "PARAMETERS", "Limit", "check", "invalid", "missing", "suggest", "unknown"]
 
 _MAX_SHOWN = 100  # characters of a value quoted in a message
 
@@ -130,13 +127,3 @@ def check(name: str, value: Any, field: str | None = None) -> Any:
     """Checks ``value`` against ``PARAMETERS[name]``; ``field`` names it in the error (default
     ``name``). Returns the value as a float."""
     return PARAMETERS[name].check(value, field or name)
-
-
-_RUST_FORM = re.compile(r"invalid parameter (`[^`]*`)(.*?): allowed ", re.DOTALL)
-
-
-def reword(message: str) -> str:
-    """A message of the compiled kernels (``invalid parameter `x` = v: allowed …``) in the form of
-    :func:`invalid` (``invalid `x` = v: expected …``); other messages unchanged."""
-    out = _RUST_FORM.sub(r"invalid \1\2: expected ", message, count=1)
-    return out.replace("invalid parameter `", "invalid `", 1)

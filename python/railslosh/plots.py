@@ -361,7 +361,7 @@ def figure(ds: Any, stem: str) -> Any:
 
     spec = next((p for p in PLOTS if p[0] == stem), None)
     if spec is None:
-        raise ValueError(f"invalid parameter `stem` = {stem!r}: expected one of {', '.join(p[0] for p in PLOTS)}")
+        raise ValueError(f"invalid `stem` = {stem!r}: expected one of {', '.join(p[0] for p in PLOTS)}")
     if not any(n in ds.data_vars and ds[n].size for n in spec[2]) or ds.sizes.get("time", 0) < 2:
         return None
     with matplotlib.style.context(STYLE):

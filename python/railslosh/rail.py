@@ -50,7 +50,7 @@ def _floats(x: ArrayLike, field: str) -> FloatArray:
     try:
         a = np.asarray(x, dtype=np.float64)
     except (TypeError, ValueError) as exc:
-        raise ValueError(f"invalid parameter `{field}` = {x!r}: allowed numbers") from exc
+        raise ValueError(f"invalid `{field}` = {x!r}: expected numbers") from exc
     return a
 
 
@@ -59,14 +59,14 @@ def _column(x: ArrayLike, n: int | None, field: str) -> FloatArray:
     if a.ndim == 0 and n is not None:
         a = np.full(n, float(a))
     if a.ndim != 1:
-        raise ValueError(f"invalid parameter `{field}`: allowed a number or a 1-D sequence, got shape {a.shape}")
+        raise ValueError(f"invalid `{field}`: expected a number or a 1-D sequence, got shape {a.shape}")
     return np.ascontiguousarray(a)
 
 
 def _query(s: ArrayLike, field: str = "s") -> tuple[FloatArray, bool]:
     a = _floats(s, field)
     if a.ndim > 1:
-        raise ValueError(f"invalid parameter `{field}`: allowed a number or a 1-D sequence, got shape {a.shape}")
+        raise ValueError(f"invalid `{field}`: expected a number or a 1-D sequence, got shape {a.shape}")
     return np.ascontiguousarray(np.atleast_1d(a)), a.ndim == 0
 
 
@@ -148,7 +148,7 @@ class Track:
         a = _floats(rows, "rows")
         if a.ndim != 2 or not 3 <= a.shape[1] <= 6:
             raise ValueError(
-                f"invalid parameter `rows`: allowed a table of 3 to 6 columns (s, curvature, superelevation, grade, "
+                f"invalid `rows`: expected a table of 3 to 6 columns (s, curvature, superelevation, grade, "
                 f"cant_right, cant_left), got shape {a.shape}"
             )
         return cls(*(a[:, k] for k in range(a.shape[1])), units=units, **options)
@@ -235,7 +235,7 @@ class Track:
         p = _floats(points, "points")
         scalar = p.ndim == 1
         if p.shape[-1:] != (3,) or p.ndim > 2:
-            raise ValueError(f"invalid parameter `points`: allowed shape (3,) or (n, 3), got {p.shape}")
+            raise ValueError(f"invalid `points`: expected shape (3,) or (n, 3), got {p.shape}")
         s, lat, vert = self._inner.project(np.ascontiguousarray(p.reshape(-1)))
         return (s[0], lat[0], vert[0]) if scalar else (s, lat, vert)
 
@@ -347,7 +347,7 @@ def _core_profile(p: Profile | _core.Profile, field: str) -> _core.Profile:
         return p._inner
     if isinstance(p, _core.Profile):
         return p
-    raise ValueError(f"invalid parameter `{field}` = {p!r}: allowed a railslosh.rail.Profile")
+    raise ValueError(f"invalid `{field}` = {p!r}: expected a railslosh.rail.Profile")
 
 
 def contact(
@@ -412,9 +412,7 @@ def contact(
     if creepages is not None:
         c = _floats(creepages, "creepages")
         if c.shape != (3,):
-            raise ValueError(
-                f"invalid parameter `creepages`: allowed (longitudinal, lateral, spin), got shape {c.shape}"
-            )
+            raise ValueError(f"invalid `creepages`: expected (longitudinal, lateral, spin), got shape {c.shape}")
         creepages = (float(c[0]), float(c[1]), float(c[2]))
     numbers = dict(
         nominal_radius=nominal_radius,
@@ -452,7 +450,7 @@ def _number(x: Any, field: str) -> float:
     try:
         return float(x)
     except (TypeError, ValueError) as exc:
-        raise ValueError(f"invalid parameter `{field}` = {x!r}: allowed a number") from exc
+        raise ValueError(f"invalid `{field}` = {x!r}: expected a number") from exc
 
 
 __all__ = [

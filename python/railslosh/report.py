@@ -382,7 +382,7 @@ def write_report(results_dir: str | os.PathLike[str], out: str | os.PathLike[str
     d = Path(results_dir)
     nc = d / "results.nc"
     if not nc.is_file():
-        raise ValueError(f"invalid parameter `results_dir` = {str(d)!r}: allowed a directory with results.nc")
+        raise ValueError(f"invalid `results_dir` = {str(d)!r}: expected a directory with results.nc")
     ds = results.load(nc)
     pngs = sorted((d / "plots").glob("*.png"))
     if not pngs:

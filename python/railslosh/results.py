@@ -385,7 +385,7 @@ def extreme(da: Any, *, mode: str = "abs", after: float = 0.0) -> Peak | None:
     of a DataArray with a ``time`` dimension over ``t >= after``, as a :class:`Peak`; None when
     nothing finite is there. A ``component`` coordinate of one component is kept in ``component``."""
     if mode not in ("abs", "max", "min"):
-        raise ValueError(f"invalid parameter `mode` = {mode!r}: expected 'abs', 'max' or 'min'")
+        raise ValueError(f"invalid `mode` = {mode!r}: expected 'abs', 'max' or 'min'")
     da = da.transpose("time", ...)
     t = np.asarray(da["time"].values, dtype=float)
     v = np.asarray(da.values, dtype=float)[t >= after - 1e-12]
@@ -475,7 +475,7 @@ def write_vtu(
         return None
     conn = np.asarray(connectivity, dtype=np.int64)
     if conn.ndim != 2 or conn.shape[1] != 8:
-        raise ValueError(f"invalid parameter `connectivity` of shape {conn.shape}: allowed (elements, 8)")
+        raise ValueError(f"invalid `connectivity` of shape {conn.shape}: expected (elements, 8)")
     out = Path(out_dir)
     (out / name).mkdir(parents=True, exist_ok=True)
     entries = []
@@ -484,7 +484,7 @@ def write_vtu(
         for k, e in enumerate(cars):
             e = np.asarray(e, dtype=float)  # (nodes, 4, 3): r, r_x, r_y, r_z
             if conn.max() >= len(e):
-                raise ValueError(f"invalid parameter `connectivity`: node {conn.max()} of a mesh with {len(e)} nodes")
+                raise ValueError(f"invalid `connectivity`: node {conn.max()} of a mesh with {len(e)} nodes")
             mesh = meshio.Mesh(
                 points=e[:, 0, :],
                 cells=[("hexahedron", conn)],

@@ -118,7 +118,7 @@ def cases(form: str = "quick") -> list[Case]:
     """The stress matrix: ``"quick"`` (CI, about a minute on 2 cores) or ``"full"`` (tens of
     minutes; shipped scenes run to their end)."""
     if form not in ("quick", "full"):
-        raise ValueError(f"invalid parameter `form` = {form!r}: allowed 'quick' or 'full'")
+        raise ValueError(f"invalid `form` = {form!r}: expected 'quick' or 'full'")
     full = form == "full"
     out: list[Case] = []
     visc = [1e-3, 1e-1, 1e1, 1e3, 1e4] if full else [1e-3, 1e4]
@@ -320,7 +320,7 @@ def _run_scene(kw: dict[str, Any]) -> tuple[dict[str, Any], float]:
 
     d = _scenes_dir()
     if d is None:
-        raise ValueError("invalid parameter `scene`: allowed a shipped scene (examples/scenes not found)")
+        raise ValueError("invalid `scene`: expected a shipped scene (examples/scenes not found)")
     sc = scene.load_scene(d / f"{kw['name']}.toml")
     changes = dict(kw["changes"])
     if kw["t_end"] is not None:

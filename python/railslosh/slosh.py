@@ -93,9 +93,9 @@ class Motion:
     def pulse(self, axis: str, accel: float, t0: float, t1: float, ramp: float = 0.01) -> Motion:
         """Add a rectangular acceleration pulse (m/s^2) on [t0, t1] with linear ramps."""
         if axis not in AXES:
-            raise ValueError(f"invalid parameter `axis` = {axis!r}: allowed one of x, y, z")
+            raise ValueError(f"invalid `axis` = {axis!r}: expected one of x, y, z")
         if not (t1 > t0 + 2 * ramp and ramp > 0):
-            raise ValueError(f"invalid parameter `pulse` = [{t0}, {t1}] ramp {ramp}: allowed t1 > t0 + 2 ramp > t0")
+            raise ValueError(f"invalid `pulse` = [{t0}, {t1}] ramp {ramp}: expected t1 > t0 + 2 ramp > t0")
         self.acceleration[axis] = [(t0, 0.0), (t0 + ramp, accel), (t1 - ramp, accel), (t1, 0.0)]
         return self
 
@@ -219,7 +219,7 @@ def run(
     motion = motion or Motion()
     unknown = set(motion.acceleration) - set(AXES)
     if unknown:
-        raise ValueError(f"invalid parameter `motion.acceleration` axes {sorted(unknown)}: allowed x, y, z")
+        raise ValueError(f"invalid `motion.acceleration` axes {sorted(unknown)}: expected x, y, z")
     acc = [motion.acceleration.get(a, []) for a in ("x", "y", "z")]
     with progress_callback(progress, "slosh run") as on_progress:
         res = _core.run_slosh(

@@ -2,7 +2,7 @@
 bulkheads x speed, or any scene field) is one run; the results are gathered into one
 ``xarray.Dataset`` with the sweep parameters as dimensions.
 
-    >>> from railslosh import sweep
+    >>> from railslosh import _core, sweep
     >>> grid = sweep.parse_grid(["oil=light,heavy", "fill=0.5,0.7"])
     >>> ds = sweep.run_sweep("examples/scenes/crude_ecp_braking_light.toml", grid)   # LocalCluster
     >>> ds["coupler_force"].sel(oil="heavy", fill=0.7)
@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from railslosh import results, scene
+from railslosh import _core, results, scene
 from railslosh.limits import invalid, suggest
 from railslosh.scene.load import parse_value, set_dotted
 from railslosh.slosh import SimulationError
@@ -109,10 +109,37 @@ def _time_grid(sc: Any) -> np.ndarray:
     return np.linspace(0.0, n * dt, n + 1)
 
 
+#: Load channels of slosh runs, resampled by their hat-weighted mean (the vehicle runs' load filter).
+LOADS = ("force_tank", "moment_tank", "force_global", "moment_global")
+
+
+def _resample(ds: Any, grid: np.ndarray) -> Any:
+    """A slosh run's Dataset (every adaptive step) on ``grid`` (multiples of ``solver.step``): the
+    loads by their hat-weighted mean over the steps (:func:`railslosh._core.hat_mean_resample`, the
+    zero-phase anti-aliasing filter vehicle runs record their loads with, so the sweep's loads
+    carry no aliased wall ringing), every other channel by linear interpolation. The Dataset says
+    so in its ``resampling`` attribute."""
+    t = ds["time"].values
+    out = ds.interp(time=grid)
+    dt = float(grid[1] - grid[0]) if len(grid) > 1 else float(t[-1] - t[0]) or 1.0
+    for name in LOADS:
+        if name in ds:
+            v = ds[name].values.reshape(len(t), -1)
+            r = _core.hat_mean_resample(list(t), v.tolist(), dt)[: len(grid)]
+            out[name] = (ds[name].dims, r.reshape((len(grid), *ds[name].shape[1:])), ds[name].attrs)
+    out.attrs["resampling"] = (
+        f"loads ({', '.join(n for n in LOADS if n in ds)}): hat-weighted mean over the steps onto multiples of "
+        f"{dt:g} s; other channels: linear interpolation"
+    )
+    return out
+
+
 def run_point(base: Mapping[str, Any], overrides: Mapping[str, Any]) -> Any:
-    """Runs one grid point; returns its Dataset on the scene's uniform time grid (slosh runs, which
-    record every adaptive step, are interpolated onto multiples of ``solver.step``), with the run's
-    ``wall_time``, ``steps`` and ``error`` (empty when it finished) as scalar variables."""
+    """Runs one grid point; returns its Dataset on the scene's uniform time grid (vehicle runs record
+    on it already, their loads as hat-weighted means; slosh runs, which record every adaptive step,
+    are put on multiples of ``solver.step``: loads by the same hat-weighted mean, other channels
+    interpolated, see :func:`_resample`), with the run's ``wall_time``, ``steps`` and ``error``
+    (empty when it finished) as scalar variables."""
     sc = scene.load_scene(base, overrides)
     t0 = time.perf_counter()
     error = ""
@@ -127,7 +154,7 @@ def run_point(base: Mapping[str, Any], overrides: Mapping[str, Any]) -> Any:
     if len(t) <= len(grid) and np.allclose(t, grid[: len(t)], rtol=0.0, atol=1e-9):
         ds = ds.assign_coords(time=("time", grid[: len(t)], ds["time"].attrs))  # exactly the common grid
     elif len(t) >= 2:
-        ds = ds.interp(time=grid[grid <= t[-1] + 1e-9])
+        ds = _resample(ds, grid[grid <= t[-1] + 1e-9])
     stats = res.get("stats") or {}
     ds["wall_time"] = ((), time.perf_counter() - t0, {"units": "s", "long_name": "wall time of the run"})
     ds["steps"] = ((), int(stats.get("steps", 0)), {"units": "1", "long_name": "accepted steps"})

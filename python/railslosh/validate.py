@@ -116,7 +116,7 @@ def run(
     names = list(names or CASES)
     unknown = [n for n in names if n not in CASES]
     if unknown:
-        raise ValueError(f"invalid parameter `case` = {unknown}: allowed {sorted(CASES)}")
+        raise ValueError(f"invalid `case` = {unknown}: expected {sorted(CASES)}")
     records: list[Record] = []
     for n in names:
         try:

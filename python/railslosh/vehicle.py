@@ -54,7 +54,7 @@ def _table(track: Any) -> list[list[float]]:
         rows = np.asarray(track, dtype=float)
     if rows.ndim != 2 or rows.shape[1] != 6:
         raise ValueError(
-            "invalid parameter `track`: allowed a rail.Track or rows (s, curvature, superelevation, grade, "
+            "invalid `track`: expected a rail.Track or rows (s, curvature, superelevation, grade, "
             f"cant_right, cant_left), got shape {rows.shape}"
         )
     return rows.tolist()
@@ -311,7 +311,7 @@ def run_equivalent(
     ``slosh_displacement`` (samples, cars, modes; m, along the slosh axis), ``fluid_mass`` and
     ``equivalent_model``."""
     if slosh_axis not in SLOSH_AXES:
-        raise ValueError(f"invalid parameter `slosh_axis` = {slosh_axis!r}: allowed one of {', '.join(SLOSH_AXES)}")
+        raise ValueError(f"invalid `slosh_axis` = {slosh_axis!r}: expected one of {', '.join(SLOSH_AXES)}")
     fill = limits.check("fill", fill)
     drive_speed, times, torques = _drive_and_brake(drive, speed, brake)
     with progress_callback(progress, "vehicle run") as on_progress:
@@ -367,7 +367,7 @@ def read_stream(path: str | os.PathLike[str]) -> dict[str, Any]:
     for name, values in col.items():
         m = pattern.match(name)
         if m is None:
-            raise ValueError(f"invalid parameter `path` = {os.fspath(path)!r}: unknown column {name!r}")
+            raise ValueError(f"invalid `path` = {os.fspath(path)!r}: unknown column {name!r}")
         key, i, c = m.group(1), int(m.group(2)), m.group(3)
         groups.setdefault(key, {})[(i, comp[c])] = values
         width[key] = 0 if c is None else max(width.get(key, 0), comp[c] + 1)

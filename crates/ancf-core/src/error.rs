@@ -6,7 +6,7 @@ use thiserror::Error;
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum AncfError {
     /// A parameter is outside its allowed range.
-    #[error("invalid parameter `{field}` = {value}: allowed {allowed}")]
+    #[error("invalid `{field}` = {value}: expected {allowed}")]
     InvalidParameter {
         /// Name of the offending field, as the user spelled it.
         field: String,

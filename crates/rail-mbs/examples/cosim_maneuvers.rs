@@ -28,7 +28,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .collect();
     let get = |k: &str| args.iter().find(|(a, _)| a == k).map(|(_, v)| v.clone());
     let num = |k: &str, d: f64| -> Result<f64, String> {
-        get(k).map_or(Ok(d), |v| v.parse().map_err(|_| format!("invalid parameter `{k}` = {v}: allowed a number")))
+        get(k).map_or(Ok(d), |v| v.parse().map_err(|_| format!("invalid `{k}` = {v}: expected a number")))
     };
     let out = std::path::PathBuf::from(get("out").unwrap_or("/tmp/cosim_maneuvers".into()));
     let (dt, h, after) = (num("dt", 0.005)?, num("h", 0.0025)?, num("after", 2.0)?);

@@ -220,7 +220,7 @@ impl Instance {
         let kind = match v[VR_MODEL] as i64 {
             0 => ModelKind::Pendulum,
             1 => ModelKind::Ancf,
-            k => return Err(format!("invalid parameter `model` = {k}: allowed 0 (pendulum) or 1 (ANCF)")),
+            k => return Err(format!("invalid `model` = {k}: expected 0 (pendulum) or 1 (ANCF)")),
         };
         let cfg = ModelConfig {
             kind,
@@ -308,14 +308,14 @@ impl Instance {
             Causality::Input => {
                 self.require("setting an input", &[Mode::Instantiated, Mode::Initialization, Mode::Event, Mode::Step])?;
                 if !x.is_finite() {
-                    return Err(format!("invalid input `{}` = {x}: allowed a finite number", v.name));
+                    return Err(format!("invalid input `{}` = {x}: expected a finite number", v.name));
                 }
             }
             Causality::Parameter => {
                 self.require("setting a parameter", &[Mode::Instantiated, Mode::Initialization])?;
                 let (lo, hi) = (v.min.unwrap_or(f64::MIN), v.max.unwrap_or(f64::MAX));
                 if !(x.is_finite() && x >= lo && x <= hi) {
-                    return Err(format!("invalid parameter `{}` = {x}: allowed [{lo}, {hi}]", v.name));
+                    return Err(format!("invalid `{}` = {x}: expected [{lo}, {hi}]", v.name));
                 }
             }
             c => return Err(format!("{} has causality {c:?} and cannot be set", vr_name(i))),
@@ -372,7 +372,7 @@ impl Instance {
     pub fn do_step(&mut self, t: f64, h: f64) -> Result<f64, String> {
         self.require("fmi3DoStep", &[Mode::Step])?;
         if !(h.is_finite() && h > 0.0) {
-            return Err(format!("invalid communicationStepSize {h}: allowed a finite number > 0"));
+            return Err(format!("invalid communicationStepSize {h}: expected a finite number > 0"));
         }
         let tol = 1e-9 * (1.0 + self.time.abs()).max(h);
         if !t.is_finite() || (t - self.time).abs() > tol {

@@ -20,7 +20,7 @@ pub fn check_finite(u: &TankInput) -> Result<(), String> {
     for (name, v) in groups {
         for (c, x) in ["x", "y", "z"].iter().zip(v) {
             if !x.is_finite() {
-                return Err(format!("invalid input `{name}_{c}` = {x}: allowed a finite number"));
+                return Err(format!("invalid input `{name}_{c}` = {x}: expected a finite number"));
             }
         }
     }
@@ -75,7 +75,7 @@ pub struct ModelConfig {
 }
 
 fn invalid(name: &str, value: impl std::fmt::Display, allowed: &str) -> String {
-    format!("invalid parameter `{name}` = {value}: allowed {allowed}")
+    format!("invalid `{name}` = {value}: expected {allowed}")
 }
 
 fn check_range(name: &str, x: f64, lo: f64, hi: f64) -> Result<(), String> {

@@ -224,14 +224,14 @@ fn state_machine_rejects_invalid_calls() {
     assert_eq!(fmu.mode(), Mode::Instantiated);
 
     let checks: Vec<(CallCheck, &str)> = vec![
-        (Box::new(|f: &Fmu| f.set(VR_FILL, 1.5)), "invalid parameter `fill` = 1.5: allowed [0.01, 0.97]"),
+        (Box::new(|f: &Fmu| f.set(VR_FILL, 1.5)), "invalid `fill` = 1.5: expected [0.01, 0.97]"),
         (Box::new(|f: &Fmu| f.set(VR_FORCE, 1.0)), "`F_x` (vr 13) has causality Output and cannot be set"),
         (Box::new(|f: &Fmu| f.set(VR_MASS, 1.0)), "cannot be set"),
         (Box::new(|f: &Fmu| f.set(VR_ACCELERATION, f64::NAN)), "invalid input `a_x` = NaN"),
         (Box::new(|f: &Fmu| f.set(999, 1.0)), "unknown value reference 999"),
         (Box::new(|f: &Fmu| f.set(VR_MODEL, 1.0)), "`model` (vr 22) is Int32, not Float64"),
-        (Box::new(|f: &Fmu| f.set_int(VR_MODEL, 5)), "invalid parameter `model` = 5: allowed [0, 1]"),
-        (Box::new(|f: &Fmu| f.set_int(VR_COUNTS, 0)), "invalid parameter `n_length` = 0"),
+        (Box::new(|f: &Fmu| f.set_int(VR_MODEL, 5)), "invalid `model` = 5: expected [0, 1]"),
+        (Box::new(|f: &Fmu| f.set_int(VR_COUNTS, 0)), "invalid `n_length` = 0"),
         (
             Box::new(|f: &Fmu| {
                 let x = [1.0, 2.0];

@@ -45,7 +45,7 @@ fn run<T: Send>(py: Python<'_>, f: impl FnOnce() -> Result<T, CosimError> + Send
 }
 
 fn bad(field: &str, value: impl std::fmt::Display, allowed: &str) -> PyErr {
-    PyValueError::new_err(format!("invalid parameter `{field}` = {value}: allowed {allowed}"))
+    PyValueError::new_err(format!("invalid `{field}` = {value}: expected {allowed}"))
 }
 
 fn vec3(obj: &Bound<'_, PyAny>, field: &str) -> PyResult<[f64; 3]> {

@@ -297,7 +297,7 @@ impl PyFluid {
             "casson" => Rheology::Casson { viscosity, yield_stress },
             other => {
                 return Err(PyValueError::new_err(format!(
-                    "invalid parameter `model` = {other:?}: allowed one of newtonian, bingham, herschel-bulkley, oldroyd, casson"
+                    "invalid `model` = {other:?}: expected one of newtonian, bingham, herschel-bulkley, oldroyd, casson"
                 )));
             }
         };
@@ -440,7 +440,7 @@ impl PyFluidBody {
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>, Bound<'py, PyAny>)> {
         if index >= self.inner.elements.len() {
             return Err(PyValueError::new_err(format!(
-                "invalid parameter `index` = {index}: allowed an integer in [0, {})",
+                "invalid `index` = {index}: expected an integer in [0, {})",
                 self.inner.elements.len()
             )));
         }
@@ -460,7 +460,7 @@ impl PyFluidBody {
     /// Global indices of the 96 compact coordinates of element `index`.
     fn element_dofs(&self, index: usize) -> PyResult<Vec<usize>> {
         if index >= self.inner.elements.len() {
-            return Err(PyValueError::new_err(format!("invalid parameter `index` = {index}")));
+            return Err(PyValueError::new_err(format!("invalid `index` = {index}")));
         }
         Ok((0..96).map(|c| self.inner.global_index(index, c)).collect())
     }
@@ -535,8 +535,7 @@ fn run_slosh<'py>(
     use ancf_core::tank::{Bulkhead, TankGeometry, TankShape};
     use rail_mbs::slosh::{PiecewiseAcceleration, PrescribedMotion, SloshFrame, SloshRun, SloshSystem, StepperChoice};
     let choice = StepperChoice::parse(stepper).map_err(crate::to_py)?;
-    let bad =
-        |f: &str, v: String, a: &str| PyValueError::new_err(format!("invalid parameter `{f}` = {v}: allowed {a}"));
+    let bad = |f: &str, v: String, a: &str| PyValueError::new_err(format!("invalid `{f}` = {v}: expected {a}"));
     let shape = match (tank_shape, tank_dims.as_slice()) {
         ("cylinder", &[length, radius, head_depth]) => TankShape::Cylinder { length, radius, head_depth },
         ("elliptic", &[length, semi_axis_y, semi_axis_z]) => {

@@ -41,7 +41,7 @@ fn detached<T: Send, F: FnOnce() -> T + Send>(py: Python<'_>, f: F) -> PyResult<
 }
 
 fn invalid(field: &str, value: impl std::fmt::Display, allowed: &str) -> PyErr {
-    PyValueError::new_err(format!("invalid parameter `{field}` = {value}: allowed {allowed}"))
+    PyValueError::new_err(format!("invalid `{field}` = {value}: expected {allowed}"))
 }
 
 fn finite(field: &str, v: f64) -> PyResult<f64> {
@@ -692,7 +692,7 @@ pub fn wheel_rail_contact<'py>(
         (None, Some(p)) => VerticalTarget::Penetration(in_range("penetration", p, 1e-9, 2e-3, "m")?),
         _ => {
             return Err(PyValueError::new_err(
-                "invalid parameters `load`/`penetration`: allowed exactly one of them (load in N or penetration in m)",
+                "invalid `load`/`penetration`: expected exactly one of them (load in N or penetration in m)",
             ));
         }
     };

@@ -454,6 +454,27 @@ fn model_dict<'py>(py: Python<'py>, m: &EquivalentModel) -> PyResult<Bound<'py, 
     Ok(d)
 }
 
+/// The hat-weighted means (`rail_mbs::vehicle::hat_mean_resample`, the load filter of vehicle
+/// runs) of a series `values` (samples × channels) at increasing times `t`, on the grid
+/// t₀, t₀ + `dt`, … up to the last time: returns (grid samples × channels).
+#[pyfunction]
+pub fn hat_mean_resample<'py>(
+    py: Python<'py>,
+    t: Vec<f64>,
+    values: Vec<Vec<f64>>,
+    dt: f64,
+) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
+    let out = compute(py, move || rail_mbs::vehicle::hat_mean_resample(&t, &values, dt))?;
+    let m = out.first().map_or(0, Vec::len);
+    if out.iter().any(|r| r.len() != m) {
+        return Err(pyo3::exceptions::PyValueError::new_err(
+            "invalid `values`: expected rows of equal length (one per sample)",
+        ));
+    }
+    let n = out.len();
+    Ok(PyArray1::from_vec(py, out.into_iter().flatten().collect()).reshape([n, m])?)
+}
+
 /// `λ = ω₁²R/g` of a horizontal circular cylinder at liquid depth fraction `h/2R` (the Rust
 /// table of `rail_mbs::vehicle::equivalent`, interpolated).
 #[pyfunction]
@@ -570,5 +591,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run_equivalent_train, m)?)?;
     m.add_function(wrap_pyfunction!(equivalent_model, m)?)?;
     m.add_function(wrap_pyfunction!(equivalent_lambda, m)?)?;
+    m.add_function(wrap_pyfunction!(hat_mean_resample, m)?)?;
     Ok(())
 }

@@ -102,7 +102,7 @@ class VehicleParticipant(Protocol):
 
 def invalid(name: str, value: object, allowed: str) -> ValueError:
     """The project's error for a bad parameter: names the field and the allowed range."""
-    return ValueError(f"invalid parameter `{name}` = {value!r}: allowed {allowed}")
+    return ValueError(f"invalid `{name}` = {value!r}: expected {allowed}")
 
 
 def check_positive(name: str, value: float, *, allow_zero: bool = False) -> float:

@@ -21,7 +21,7 @@ from typing import Any
 from railslosh import _core, mesh
 from railslosh.constants import MPH
 from railslosh.fluid_model import SLOSH_MODELS
-from railslosh.limits import FILL, PARAMETERS, Limit, invalid, reword, unknown
+from railslosh.limits import FILL, PARAMETERS, Limit, invalid, unknown
 from railslosh.vehicle import WALL_DAMPING_RATIO
 
 PRESETS = ("table1", "tangent")
@@ -440,7 +440,7 @@ def scoped(exc: Exception, section: str, *, prefix: bool = True) -> ValueError:
     """A model's error (e.g. of the compiled kernels) as a scene error: in the form of
     :func:`railslosh.limits.invalid`, its field put under ``section`` when ``prefix``
     (``viscosity`` -> ``fluid.viscosity``); a message naming no field is said of the section."""
-    msg = reword(str(exc))
+    msg = str(exc)
     if not msg.startswith("invalid `"):
         return ValueError(f"invalid `{section}`: {msg}")
     if prefix:

@@ -19,7 +19,7 @@ use crate::slosh::{PrescribedMotion, SloshFrame, SloshSystem, TankFrameInput, Ta
 #[derive(Debug, thiserror::Error)]
 pub enum CosimError {
     /// A parameter or input is outside its allowed range.
-    #[error("invalid parameter `{field}` = {value}: allowed {allowed}")]
+    #[error("invalid `{field}` = {value}: expected {allowed}")]
     InvalidParameter {
         /// Name of the offending field (config field or input key).
         field: String,

@@ -220,7 +220,7 @@ impl fmt::Display for Quantity {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum IntegratorError {
     /// A parameter is outside its admissible range.
-    #[error("invalid parameter `{field}` = {value}: allowed {allowed}")]
+    #[error("invalid `{field}` = {value}: expected {allowed}")]
     InvalidParameter {
         /// Parameter name.
         field: &'static str,

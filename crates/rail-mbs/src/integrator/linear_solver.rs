@@ -85,7 +85,7 @@ pub(crate) fn for_kkt(
                 )));
             }
             params.validate().map_err(|(field, value, allowed)| {
-                LinearFailure::Generic(format!("invalid parameter `{field}` = {value}: allowed {allowed}"))
+                LinearFailure::Generic(format!("invalid `{field}` = {value}: expected {allowed}"))
             })?;
             Box::new(Krylov::new(params, pattern))
         }

@@ -50,7 +50,7 @@ pub use fluid::{
 };
 pub use run::{
     BrakeScope, LoadFilter, Observer, Progress, SampleSink, TrainFailure, TrainRecord, TrainScenario, build_train,
-    run_train, run_train_observed, run_train_streamed, stopped_by_observer,
+    hat_mean_resample, run_train, run_train_observed, run_train_streamed, stopped_by_observer,
 };
 pub use tank_car::{
     BodyMass, CarBodies, CarPlacement, ContactParams, SuspensionParams, TankCarParams, WheelLoad, add_coupler,

@@ -77,7 +77,7 @@ pub enum ValidationError {
         searched: Vec<PathBuf>,
     },
     /// No case of that name.
-    #[error("invalid parameter `case` = {0:?}: allowed one of {CASES:?}")]
+    #[error("invalid `case` = {0:?}: expected one of {CASES:?}")]
     UnknownCase(String),
     /// The reference data could not be read or parsed.
     #[error("{file}: {message}")]
