@@ -489,7 +489,7 @@ pub fn hat_mean_resample(t: &[f64], f: &[Vec<f64>], dt: f64) -> Result<Vec<Vec<f
     if !(dt.is_finite() && dt > 0.0) {
         return Err(invalid("dt", dt, "a finite interval > 0"));
     }
-    if let Some(i) = t.windows(2).position(|w| !(w[1] > w[0])) {
+    if let Some(i) = t.windows(2).position(|w| w[1] <= w[0] || w[1].is_nan()) {
         return Err(invalid(&format!("t[{}]", i + 1), t[i + 1], "increasing times"));
     }
     let n_rec = ((t[t.len() - 1] - t[0]) / dt + 1e-9).floor() as usize;
