@@ -848,8 +848,8 @@ mod tests {
                 let x = lo + (hi - lo) * j as f64 / n as f64;
                 let w = (1.0 - (x - tk).abs() / dt) * if j == 0 || j == n { 0.5 } else { 1.0 };
                 den += w;
-                for c in 0..2 {
-                    num[c] += w * lin(x, c);
+                for (c, n) in num.iter_mut().enumerate() {
+                    *n += w * lin(x, c);
                 }
             }
             for c in 0..2 {
