@@ -472,7 +472,7 @@ pub fn hat_mean_resample<'py>(
         ));
     }
     let n = out.len();
-    Ok(PyArray1::from_vec(py, out.into_iter().flatten().collect()).reshape([n, m])?)
+    PyArray1::from_vec(py, out.into_iter().flatten().collect()).reshape([n, m])
 }
 
 /// `λ = ω₁²R/g` of a horizontal circular cylinder at liquid depth fraction `h/2R` (the Rust
