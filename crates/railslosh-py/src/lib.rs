@@ -531,9 +531,9 @@ fn run_slosh<'py>(
     wall_damping_ratio: f64,
     snapshot_every: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
-    use ancf_core::contact::{ContactPointRule, WallContact, WallContactLaw};
-    use ancf_core::tank::{Bulkhead, TankGeometry, TankShape};
-    use rail_mbs::slosh::{PiecewiseAcceleration, PrescribedMotion, SloshFrame, SloshRun, SloshSystem, StepperChoice};
+    use ancf_core::contact::ContactPointRule;
+    use ancf_core::tank::{Bulkhead, TankShape};
+    use rail_mbs::slosh::{PiecewiseAcceleration, SloshFrame, SloshScenario, StepperChoice};
     let choice = StepperChoice::parse(stepper).map_err(crate::to_py)?;
     let bad = |f: &str, v: String, a: &str| PyValueError::new_err(format!("invalid `{f}` = {v}: expected {a}"));
     let shape = match (tank_shape, tank_dims.as_slice()) {
@@ -566,89 +566,39 @@ fn run_slosh<'py>(
     if !(h.is_finite() && h > 0.0 && h <= t_end) {
         return Err(bad("h", h.to_string(), "a finite number in (0, t_end]"));
     }
-    // Failure guards (issue 8): relative volume error and wall penetration per smallest element edge.
-    for (name, x) in [("volume_tolerance", volume_tolerance), ("penetration_limit", penetration_limit)] {
-        if x.is_nan() || x <= 0.0 {
-            return Err(bad(name, x.to_string(), "a number > 0 (inf disables the check)"));
-        }
-    }
-    if !(contact_stiffness_factor.is_finite() && contact_stiffness_factor > 0.0) {
-        return Err(bad("contact_stiffness_factor", contact_stiffness_factor.to_string(), "a finite number > 0"));
-    }
     if !(snapshot_every.is_finite() && snapshot_every >= 0.0) {
         return Err(bad("snapshot_every", snapshot_every.to_string(), "a finite interval >= 0 s (0: no snapshots)"));
     }
-    let (m, f) = (mesh.inner.clone(), fluid.inner);
-    let connectivity: Vec<i64> = m.elements.iter().flatten().map(|&n| n as i64).collect();
+    // The model, with the library's defaults for what the keywords leave (rail_mbs::slosh::scenario).
+    let mut scenario = SloshScenario::new(mesh.inner.clone(), fluid.inner, shape);
+    scenario.bulkheads = bulkheads.iter().map(|&(x, thickness)| Bulkhead { x, thickness }).collect();
+    scenario.gravity = gravity;
+    scenario.frame = frame;
+    scenario.quadrature = QuadratureOptions { viscous: viscous_points, penalty: penalty_points, mass: 4 };
+    scenario.contact_points_per_edge = contact_points_per_edge;
+    scenario.contact_point_rule = point_rule;
+    scenario.contact_stiffness_factor = contact_stiffness_factor;
+    scenario.wall_damping_ratio = wall_damping_ratio;
+    // Failure guards (issue 8): relative volume error and wall penetration per smallest element edge.
+    scenario.volume_tolerance = volume_tolerance;
+    scenario.penetration_limit = penetration_limit;
+    scenario.validate().map_err(to_py)?;
+    let connectivity: Vec<i64> = scenario.mesh.elements.iter().flatten().map(|&n| n as i64).collect();
     let mut observer = PyProgress::new(progress);
     let obs = &mut observer;
     let result = compute(py, move || {
-        let q = QuadratureOptions { viscous: viscous_points, penalty: penalty_points, mass: 4 };
-        let body = FluidBody::new(m, f, q)?;
-        let bh = bulkheads.iter().map(|&(x, thickness)| Bulkhead { x, thickness }).collect();
-        let geo = TankGeometry::new(shape, bh)?;
-        let depth =
-            (body.mesh.free_surface_z - body.mesh.nodes.iter().map(|n| n[2]).fold(f64::INFINITY, f64::min)).max(1e-3);
-        let g = (gravity[0].powi(2) + gravity[1].powi(2) + gravity[2].powi(2)).sqrt().max(1e-3);
-        let mut law = WallContactLaw::default_for(f.density, g, depth).with_damping_ratio(
-            wall_damping_ratio,
-            f.density,
-            g,
-            depth,
-        )?;
-        // k × s with the damping ratio kept (c ∝ k^1.5 there)
-        law.stiffness *= contact_stiffness_factor;
-        law.damping *= contact_stiffness_factor.powf(1.5);
-        law.points_per_edge = contact_points_per_edge;
-        law.point_rule = point_rule;
-        let contact = WallContact::new(&body, geo, law)?;
-        let mut motion = PrescribedMotion::at_rest([0.0; 3]);
         let names = ["acceleration.x", "acceleration.y", "acceleration.z"];
         for d in 0..3 {
             if !acceleration[d].is_empty() {
-                motion.translation[d] = PiecewiseAcceleration::new(names[d], &acceleration[d])?;
+                scenario.motion.translation[d] = PiecewiseAcceleration::new(names[d], &acceleration[d])?;
             }
         }
         if let Some(axis) = rotation_axis {
-            motion.rotation = Some((axis, PiecewiseAcceleration::new("angular_acceleration", &angular_acceleration)?));
+            scenario.motion.rotation =
+                Some((axis, PiecewiseAcceleration::new("angular_acceleration", &angular_acceleration)?));
         }
-        let mut sys = SloshSystem::new(body, contact, motion, gravity, frame)?;
-        sys.volume_tolerance = volume_tolerance;
-        sys.penetration_limit *= penetration_limit / rail_mbs::slosh::system::PENETRATION_LIMIT_FACTOR;
-        let params = rail_mbs::defaults::slosh_params();
-        let explicit = rail_mbs::integrator::ExplicitParams::default();
-        let reason;
-        let mut run = match &resume_from {
-            // Issue 8: continue a run from its last checkpoint, bitwise as if never stopped.
-            Some(path) => {
-                let bytes = rail_mbs::integrator::CheckpointFile::read_bytes(path).map_err(|e| {
-                    ancf_core::error::invalid("resume_from", path.display(), &format!("a checkpoint file ({e})"))
-                })?;
-                let resumed = SloshRun::resume_from_bytes(sys, &bytes, params, explicit).map_err(|e| {
-                    ancf_core::error::invalid(
-                        "resume_from",
-                        path.display(),
-                        &format!("a checkpoint of a run of this same scene ({e})"),
-                    )
-                })?;
-                let used = resumed.stepper.name();
-                if choice != StepperChoice::Auto && used != stepper {
-                    return Err(ancf_core::error::invalid(
-                        "stepper",
-                        stepper,
-                        &format!("\"{used}\" or \"auto\": the checkpoint in resume_from is of an {used} run"),
-                    ));
-                }
-                reason = format!("resumed: {used}");
-                resumed
-            }
-            None => {
-                let (run, why) = SloshRun::with_choice(sys, 0.0, choice, h, params, explicit)
-                    .map_err(|e| AncfError::NonFinite { what: e.to_string(), element: 0 })?;
-                reason = why;
-                run
-            }
-        };
+        // Issue 8: `resume_from` continues a run from its last checkpoint, bitwise as if never stopped.
+        let (mut run, reason) = scenario.start(choice, h, resume_from.as_deref())?;
         run.set_snapshot_every(snapshot_every).map_err(|e| AncfError::NonFinite { what: e.to_string(), element: 0 })?;
         if let Some(path) = &checkpoint {
             if checkpoint_every == 0 {

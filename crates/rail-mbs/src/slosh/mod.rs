@@ -8,11 +8,13 @@
 pub mod linear_theory;
 pub mod modes;
 pub mod motion;
+pub mod scenario;
 pub mod system;
 pub mod validate;
 
 pub use modes::{LinearModes, linear_modes};
 pub use motion::{PiecewiseAcceleration, PrescribedMotion, TankFrameInput, TankFrameSample, TankState};
+pub use scenario::SloshScenario;
 pub use system::{SloshFrame, SloshSystem};
 
 use nalgebra::Vector3;
