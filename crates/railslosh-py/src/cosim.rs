@@ -322,15 +322,7 @@ impl PySloshParticipant {
     /// Integrator statistics.
     #[getter]
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let s = self.inner.stats();
-        let d = PyDict::new(py);
-        d.set_item("steps", s.steps)?;
-        d.set_item("rejected_steps", s.rejected_steps)?;
-        d.set_item("newton_iterations", s.newton_iterations)?;
-        d.set_item("factorizations", s.factorizations)?;
-        d.set_item("jacobian_evaluations", s.jacobian_evaluations)?;
-        d.set_item("time_total", s.time_total.as_secs_f64())?;
-        Ok(d)
+        crate::stats_dict(py, self.inner.stats())
     }
 }
 

@@ -627,6 +627,26 @@ fn run_slosh<'py>(
     })?;
     observer.finish()?;
     let (rec, err, stats, margins, used, reason, snapshots) = result;
+    let d = slosh_record_dict(py, rec)?;
+    d.set_item("margins", margins_dict(py, &margins)?)?;
+    // the vehicle runs' snapshot layout, with one "car": (t, [nodes × 4 × 3]), tank frame
+    let snaps = pyo3::types::PyList::empty(py);
+    for (t, e) in snapshots {
+        let n = e.len() / 12;
+        snaps.append((t, vec![PyArray1::from_vec(py, e).reshape([n, 4, 3])?]))?;
+    }
+    d.set_item("snapshots", snaps)?;
+    let ne = connectivity.len() / 8;
+    d.set_item("connectivity", PyArray1::from_vec(py, connectivity).reshape([ne, 8])?)?;
+    d.set_item("stepper", used)?;
+    d.set_item("stepper_reason", reason)?;
+    d.set_item("error", err)?;
+    d.set_item("stats", stats_dict(py, &stats)?)?;
+    Ok(d)
+}
+
+/// The time series of a slosh run's record as numpy arrays (vectors as n × 3).
+fn slosh_record_dict<'py>(py: Python<'py>, rec: rail_mbs::slosh::SloshRecord) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     let v3 = |x: &Vec<[f64; 3]>| -> PyResult<Bound<'py, PyAny>> {
         let n = x.len();
@@ -648,31 +668,22 @@ fn run_slosh<'py>(
     d.set_item("energy_error", PyArray1::from_vec(py, rec.energy_error))?;
     d.set_item("min_volume_ratio", PyArray1::from_vec(py, rec.min_volume_ratio))?;
     d.set_item("containment_gap", PyArray1::from_vec(py, rec.containment_gap))?;
-    d.set_item("margins", margins_dict(py, &margins)?)?;
-    // the vehicle runs' snapshot layout, with one "car": (t, [nodes × 4 × 3]), tank frame
-    let snaps = pyo3::types::PyList::empty(py);
-    for (t, e) in snapshots {
-        let n = e.len() / 12;
-        snaps.append((t, vec![PyArray1::from_vec(py, e).reshape([n, 4, 3])?]))?;
-    }
-    d.set_item("snapshots", snaps)?;
-    let ne = connectivity.len() / 8;
-    d.set_item("connectivity", PyArray1::from_vec(py, connectivity).reshape([ne, 8])?)?;
-    d.set_item("stepper", used)?;
-    d.set_item("stepper_reason", reason)?;
-    d.set_item("error", err)?;
-    let st = PyDict::new(py);
-    st.set_item("steps", stats.steps)?;
-    st.set_item("rejected_steps", stats.rejected_steps)?;
-    st.set_item("newton_iterations", stats.newton_iterations)?;
-    st.set_item("factorizations", stats.factorizations)?;
-    st.set_item("jacobian_evaluations", stats.jacobian_evaluations)?;
-    st.set_item("time_assembly", stats.time_assembly.as_secs_f64())?;
-    st.set_item("time_factorization", stats.time_factorization.as_secs_f64())?;
-    st.set_item("time_solve", stats.time_solve.as_secs_f64())?;
-    st.set_item("time_total", stats.time_total.as_secs_f64())?;
-    d.set_item("stats", st)?;
     Ok(d)
+}
+
+/// An integrator's statistics (`rail_mbs::integrator::Stats`) as a dict, times in s.
+pub(crate) fn stats_dict<'py>(py: Python<'py>, s: &rail_mbs::integrator::Stats) -> PyResult<Bound<'py, PyDict>> {
+    let st = PyDict::new(py);
+    st.set_item("steps", s.steps)?;
+    st.set_item("rejected_steps", s.rejected_steps)?;
+    st.set_item("newton_iterations", s.newton_iterations)?;
+    st.set_item("factorizations", s.factorizations)?;
+    st.set_item("jacobian_evaluations", s.jacobian_evaluations)?;
+    st.set_item("time_assembly", s.time_assembly.as_secs_f64())?;
+    st.set_item("time_factorization", s.time_factorization.as_secs_f64())?;
+    st.set_item("time_solve", s.time_solve.as_secs_f64())?;
+    st.set_item("time_total", s.time_total.as_secs_f64())?;
+    Ok(st)
 }
 
 /// The worst invariant margins of a run (`rail_mbs::invariants::Margins`) as a dict
