@@ -79,6 +79,12 @@ pub struct FluidMesh {
 }
 
 impl FluidMesh {
+    /// Depth of the liquid in the reference configuration: the free surface's height above the
+    /// lowest node (m).
+    pub fn liquid_depth(&self) -> f64 {
+        self.free_surface_z - self.nodes.iter().map(|n| n[2]).fold(f64::INFINITY, f64::min)
+    }
+
     /// Number of nodes.
     pub fn n_nodes(&self) -> usize {
         self.nodes.len()

@@ -368,7 +368,7 @@ fn tank_geometry_free_surface_and_volume_converge() {
     // elliptic section: liquid depth of the half-full SwRI tank is the vertical semi-axis
     let sw = elliptic_cylinder(&EllipticCylinderSpec::swri(2, 4, 2)).unwrap();
     assert!(sw.free_surface_z.abs() < 1e-12);
-    let depth = sw.free_surface_z - sw.nodes.iter().map(|n| n[2]).fold(f64::INFINITY, f64::min);
+    let depth = sw.liquid_depth();
     assert!((depth - 0.132130).abs() < 1e-5, "{depth}");
 }
 

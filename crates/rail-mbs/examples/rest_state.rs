@@ -31,7 +31,7 @@ fn main() {
         "swri" => {
             let spec = EllipticCylinderSpec::swri(c[0], c[1], c[2]);
             let mesh = elliptic_cylinder(&spec).unwrap();
-            let depth = mesh.free_surface_z - mesh.nodes.iter().map(|n| n[2]).fold(f64::INFINITY, f64::min);
+            let depth = mesh.liquid_depth();
             let geo = TankGeometry::new(
                 TankShape::EllipticCylinder {
                     length: spec.length,

@@ -216,7 +216,7 @@ fn rest_lambda_min(mesh: RestMesh, np: usize, ppe: usize, stabilization: Option<
         RestMesh::Swri(c) => {
             let spec = EllipticCylinderSpec::swri(c[0], c[1], c[2]);
             let mesh = elliptic_cylinder(&spec).unwrap();
-            let depth = mesh.free_surface_z - mesh.nodes.iter().map(|n| n[2]).fold(f64::INFINITY, f64::min);
+            let depth = mesh.liquid_depth();
             let shape = TankShape::EllipticCylinder {
                 length: spec.length,
                 semi_axis_y: spec.semi_axis_y,
@@ -288,7 +288,7 @@ fn a_tank_at_rest_for_20_s_keeps_a_flat_energy() {
     use ancf_core::mesh::{EllipticCylinderSpec, elliptic_cylinder};
     let spec = EllipticCylinderSpec::swri(1, 2, 2);
     let mesh = elliptic_cylinder(&spec).unwrap();
-    let depth = mesh.free_surface_z - mesh.nodes.iter().map(|n| n[2]).fold(f64::INFINITY, f64::min);
+    let depth = mesh.liquid_depth();
     let mut fluid = liquid(RHO, Rheology::Newtonian { viscosity: 1e-3 }, depth, depth / 2.0).unwrap();
     fluid.shear_stabilization = rail_mbs::defaults::default_shear_stabilization(RHO, depth / 2.0);
     let body = FluidBody::new(mesh, fluid, QuadratureOptions { viscous: 4, penalty: 4, mass: 4 }).unwrap();

@@ -41,8 +41,7 @@ pub fn build(config: &ModelConfig, t0: f64) -> Result<Box<dyn FmuModel>, String>
         n_height: config.counts[2],
     };
     let mesh = elliptic_cylinder(&spec).map_err(|e| e.to_string())?;
-    let z_min = mesh.nodes.iter().map(|n| n[2]).fold(f64::INFINITY, f64::min);
-    let depth = mesh.free_surface_z - z_min;
+    let depth = mesh.liquid_depth();
     let h_el = (config.length / spec.n_length as f64)
         .min(2.0 * config.semi_axis_y / spec.n_width as f64)
         .min(depth / spec.n_height as f64);

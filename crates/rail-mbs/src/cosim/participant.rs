@@ -279,10 +279,7 @@ impl SloshParticipant {
     /// the tank at rest with gravity −g along tank z.
     pub fn new(config: SloshParticipantConfig) -> Result<Self, CosimError> {
         config.validate()?;
-        let depth = {
-            let zmin = config.mesh.nodes.iter().map(|n| n[2]).fold(f64::INFINITY, f64::min);
-            config.mesh.free_surface_z - zmin
-        };
+        let depth = config.mesh.liquid_depth();
         let law = match config.contact {
             Some(law) => law,
             None => {

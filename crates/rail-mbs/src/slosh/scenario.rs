@@ -89,8 +89,7 @@ impl SloshScenario {
 
     /// The liquid's depth at rest in the mesh (free surface − lowest node), at least 1 mm.
     pub fn depth(&self) -> f64 {
-        let lowest = self.mesh.nodes.iter().map(|n| n[2]).fold(f64::INFINITY, f64::min);
-        (self.mesh.free_surface_z - lowest).max(1e-3)
+        self.mesh.liquid_depth().max(1e-3)
     }
 
     /// The wall law: the default penalty for this liquid's depth and gravity, with the damping

@@ -102,8 +102,7 @@ impl SloshSystem {
     /// The run-time invariant monitor of this system ([`crate::invariants`]): containment
     /// within its penetration limit, default energy and volume-ratio limits.
     pub fn invariant_monitor(&self) -> crate::invariants::InvariantMonitor {
-        let nodes = &self.body.mesh.nodes;
-        let depth = self.body.mesh.free_surface_z - nodes.iter().map(|n| n[2]).fold(f64::INFINITY, f64::min);
+        let depth = self.body.mesh.liquid_depth();
         let g = Vector3::from(self.gravity).norm();
         crate::invariants::InvariantMonitor::new(
             "fluid",

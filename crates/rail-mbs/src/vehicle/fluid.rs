@@ -135,8 +135,7 @@ impl FluidVehicle {
         s.monitors = (0..s.fluids.len())
             .map(|k| {
                 let body = &s.fluids[k].body;
-                let depth =
-                    body.mesh.free_surface_z - body.mesh.nodes.iter().map(|n| n[2]).fold(f64::INFINITY, f64::min);
+                let depth = body.mesh.liquid_depth();
                 let limits = InvariantLimits::new(s.penetration_limit(k));
                 InvariantMonitor::new(format!("fluid {k}"), limits, body.total_mass(), g, depth.max(0.0))
             })
