@@ -1,12 +1,16 @@
 //! Cost per step against fluid mesh size (issue 7: "no faster than about n^1.2").
 //!
-//! `cargo run --release -p rail-mbs --example scaling -- [direct|iterative] [steps] [n1,n2,...]`
+//! `cargo run --release -p rail-mbs --example scaling -- [direct|iterative|explicit] [steps] [n1,n2,...]`
 //!
 //! Water in a 4 m × 2 m × 1.5 m box tank, 1 m deep, under a 0.3 g lateral pulse, meshed
 //! with about n ANCF bricks (4:2:1 cells). After two warm-up steps, `steps` HHT steps of
 //! 2 ms are timed one by one; one JSON line per mesh gives the median wall time per
 //! step and its split (forces + Jacobians, factorization / preconditioner, solves),
 //! Newton and Krylov iterations. Thread count: RAYON_NUM_THREADS.
+//!
+//! `explicit`: the explicit stepper (velocity Verlet, the mass factored once) instead, at a
+//! fixed step of 0.8 × its estimated stable step; the JSON line gives the median wall time per
+//! step and the stable step (issue 17: per-step cost against n, and thread scaling).
 use std::time::Instant;
 
 use ancf_core::FluidBody;
@@ -15,7 +19,7 @@ use ancf_core::contact::{WallContact, WallContactLaw};
 use ancf_core::element::QuadratureOptions;
 use ancf_core::mesh::box_mesh;
 use ancf_core::tank::{TankGeometry, TankShape};
-use rail_mbs::integrator::{Hht, HhtParams, IterativeParams, LinearSolverKind};
+use rail_mbs::integrator::{BlockMass, Explicit, ExplicitParams, Hht, HhtParams, IterativeParams, LinearSolverKind};
 use rail_mbs::slosh::{PiecewiseAcceleration, PrescribedMotion, SloshFrame, SloshSystem};
 
 /// Box counts with about `n` elements and 2:1 length:width, 2:1 width:height cells.
@@ -37,6 +41,7 @@ fn median(v: &mut [f64]) -> f64 {
 fn main() {
     let a: Vec<String> = std::env::args().skip(1).collect();
     let iterative = a.first().map(|s| s.as_str()) == Some("iterative");
+    let explicit = a.first().map(|s| s.as_str()) == Some("explicit");
     let steps: usize = a.get(1).map_or(10, |s| s.parse().expect("steps"));
     let sizes: Vec<usize> = a
         .get(2)
@@ -60,6 +65,10 @@ fn main() {
         let mut motion = PrescribedMotion::at_rest([0.0; 3]);
         motion.translation[1] = PiecewiseAcceleration::pulse(0.3 * 9.81, 0.0, 0.5, 0.01).expect("pulse");
         let mut sys = SloshSystem::new(body, contact, motion, [0.0, 0.0, -9.81], SloshFrame::Inertial).expect("system");
+        if explicit {
+            explicit_steps(sys, steps, t_build, threads);
+            continue;
+        }
         if iterative {
             let env = |k: &str, d: usize| std::env::var(k).ok().and_then(|v| v.parse().ok()).unwrap_or(d);
             let d = IterativeParams::default();
@@ -111,4 +120,49 @@ fn main() {
             failed.map_or("null".to_string(), |e| format!("{e:?}")),
         );
     }
+}
+
+/// The explicit stepper's cost per step on `sys` (module docs, `explicit`).
+fn explicit_steps(sys: SloshSystem, steps: usize, t_build: Instant, threads: usize) {
+    let (n_el, n_coords) = (sys.body.elements.len(), sys.body.n_coords());
+    let (q0, v0) = sys.initial_state(0.0);
+    let m_s = sys.body.scalar_mass().clone();
+    let t_factor = Instant::now();
+    let mut e = Explicit::new(sys, &m_s, 0.0, q0, v0, ExplicitParams::default()).expect("explicit stepper");
+    let factor = t_factor.elapsed().as_secs_f64();
+    let h = e.stable_step().expect("stable step");
+    let build = t_build.elapsed().as_secs_f64();
+    // the mass solve alone (two triangular solves for the three directions), on a copy
+    let mut mass = BlockMass::new(&m_s).expect("mass");
+    let f: Vec<f64> = (0..n_coords).map(|i| (i as f64 * 0.618_033_988_75).fract() - 0.5).collect();
+    let mut a = vec![0.0; n_coords];
+    let mut per_solve: Vec<f64> = (0..steps.max(3))
+        .map(|_| {
+            let tic = Instant::now();
+            mass.solve(&f, &mut a);
+            tic.elapsed().as_secs_f64()
+        })
+        .collect();
+    let mut per_step = Vec::with_capacity(steps);
+    let mut failed = None;
+    for k in 0..steps + 2 {
+        if k == 2 {
+            per_step.clear();
+        }
+        let tic = Instant::now();
+        if let Err(err) = e.step(h) {
+            failed = Some(err.to_string());
+            break;
+        }
+        per_step.push(tic.elapsed().as_secs_f64());
+    }
+    println!(
+        "{{\"solver\": \"explicit\", \"threads\": {threads}, \"elements\": {n_el}, \"coords\": {n_coords}, \
+         \"build_s\": {build:.3}, \"mass_factor_s\": {factor:.4}, \"step_h_s\": {h:.3e}, \"median_step_s\": {:.6}, \
+         \"median_mass_solve_s\": {:.6}, \"steps\": {}, \"failed\": {}}}",
+        if per_step.is_empty() { f64::NAN } else { median(&mut per_step) },
+        median(&mut per_solve),
+        per_step.len(),
+        failed.map_or("null".to_string(), |e| format!("{e:?}")),
+    );
 }
