@@ -19,6 +19,7 @@ MODULES = (
     "railslosh.limits",
     "railslosh.fluid_model",
     "railslosh.results",
+    "railslosh.indicators",
     "railslosh.plots",
     "railslosh.report",
     "railslosh.sweep",

@@ -12,14 +12,25 @@ side), the limits a standard gives drawn in (L/V, wheel unloading), and the sett
 
 from __future__ import annotations
 
-import json
-import math
 import os
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+# The limits of the standards and Nadal's limit live in railslosh.indicators (one definition);
+# they stay importable from here.
+from railslosh.indicators import (
+    FLANGE_ANGLE,
+    L_OVER_V_LIMIT,
+    UNLOADING_LIMIT,
+    nadal_limit,
+)
+from railslosh.indicators import L_OVER_V_STANDARD as _L_OVER_V_SOURCE
+from railslosh.indicators import UNLOADING_STANDARD as _UNLOADING_SOURCE
+from railslosh.indicators import flange_angle as _flange_angle
+from railslosh.indicators import wheel_profile as _profile
 
 __all__ = [
     "FLANGE_ANGLE",
@@ -105,25 +116,6 @@ _RESOLUTION = {
 _AXES = {"x": "Longitudinal", "y": "Lateral", "z": "Vertical"}
 _ROTATIONS = {"x": "Roll", "y": "Pitch", "z": "Yaw"}
 
-# Derailment quotient limit (Y/Q)lim = 0.8: UIC 518 (4th ed., 2009) and EN 14363:2016, where it
-# applies to the 2 m sliding mean of Y/Q; the plots show the unfiltered quotient against it.
-L_OVER_V_LIMIT = 0.8
-_L_OVER_V_SOURCE = "UIC 518, EN 14363"
-# Wheel unloading limit ΔQ/Q₀ = 0.6: UIC 530-2 and EN 14363:2016 (safety against derailment on
-# twisted track, quasi-static wheel unloading).
-UNLOADING_LIMIT = 0.6
-_UNLOADING_SOURCE = "UIC 530-2, EN 14363"
-# Flange angles of the wheel profiles (deg): S1002 (EN 13715) 70°, the AAR-1B-style profile 75°
-# (rail_mbs::profile::analytic), for Nadal's single-wheel flange-climb limit.
-FLANGE_ANGLE = {"s1002": 70.0, "aar1b": 75.0}
-
-
-def nadal_limit(flange_angle: float = 70.0, friction: float = 0.5) -> float:
-    """Nadal's flange-climb limit Y/Q = (tan δ − μ)/(1 + μ tan δ) for flange angle δ (deg) and
-    flange friction μ (0.5: dry rail, conservative); 0.95 for 70° and μ = 0.5."""
-    tan = math.tan(math.radians(flange_angle))
-    return (tan - friction) / (1.0 + friction * tan)
-
 
 def label(name: str) -> str:
     """The variable in words (:data:`LABELS`), or its ``long_name``-free name when unknown."""
@@ -150,13 +142,6 @@ def _with_unit(text: str, unit: str) -> str:
     return f"{text} ({unit})" if unit else text
 
 
-def _profile(ds: Any) -> str:
-    try:
-        return str(json.loads(ds.attrs.get("scene_json", "{}")).get("car", {}).get("wheel_profile", "s1002"))
-    except (ValueError, AttributeError):
-        return "s1002"
-
-
 def limits(ds: Any, name: str) -> list[tuple[float, str, str]]:
     """``(value in SI units, legend label, line style)`` of the standard limits of variable
     ``name``: L/V (UIC 518 / EN 14363 and Nadal for the run's wheel profile), wheel unloading
@@ -166,7 +151,7 @@ def limits(ds: Any, name: str) -> list[tuple[float, str, str]]:
     if name == "l_over_v":
         lv = float(ds.attrs.get("l_over_v_limit", L_OVER_V_LIMIT))
         prof = _profile(ds)
-        angle = FLANGE_ANGLE.get(prof, 70.0)
+        angle = _flange_angle(ds)
         return [
             (lv, f"limit {lv:g} ({_L_OVER_V_SOURCE})", "--"),
             (nadal_limit(angle), f"Nadal {nadal_limit(angle):.2f} ({prof}, δ = {angle:g}°, μ = 0.5)", ":"),
