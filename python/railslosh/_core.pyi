@@ -295,9 +295,33 @@ def wheel_rail_contact(
 # --- vehicle (crates/railslosh-py/src/vehicle.rs) ---
 
 def tank_car_parameters(car: dict[str, float] | None = None, wheel_profile: str = "s1002") -> dict[str, Any]: ...
+def track_irregularity(
+    kind: str,
+    length: float,
+    *,
+    track_class: int | None = None,
+    start: float = 0.0,
+    step: float = 0.25,
+    wavelengths: tuple[float, float] = (1.0, 70.0),
+    seed: int = 1,
+    taper: float = 20.0,
+    channels: list[str] | None = None,
+) -> dict[str, Any]: ...
+def track_irregularity_defects(
+    defects: list[dict[str, Any]],
+    *,
+    samples: dict[str, Any] | None = None,
+    start: float = 0.0,
+    end: float | None = None,
+    step: float = 0.05,
+) -> dict[str, Any]: ...
+def track_psd(
+    kind: str, channel_name: str, omega: npt.NDArray[np.float64], *, track_class: int | None = None
+) -> npt.NDArray[np.float64]: ...
 def run_train(
     track: list[list[float]],
     *,
+    irregularity: dict[str, Any] | None = None,
     cars: int = 1,
     station: float = 50.0,
     speed: float = 0.0,
@@ -325,6 +349,7 @@ def design_brake_torque(
 def run_fluid_train(
     track: list[list[float]],
     *,
+    irregularity: dict[str, Any] | None = None,
     cars: int = 1,
     station: float = 300.0,
     speed: float = 0.0,
@@ -352,6 +377,7 @@ def run_fluid_train(
 def run_equivalent_train(
     track: list[list[float]],
     *,
+    irregularity: dict[str, Any] | None = None,
     cars: int = 1,
     station: float = 50.0,
     speed: float = 0.0,

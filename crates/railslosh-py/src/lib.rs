@@ -12,6 +12,7 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 
 mod bench;
 mod cosim;
+mod irregularity;
 mod maneuvers;
 mod rail;
 mod vehicle;
@@ -783,6 +784,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(_panic_for_test, m)?)?;
     rail::register(m)?;
     vehicle::register(m)?;
+    irregularity::register(m)?;
     cosim::register(m)?;
     maneuvers::register(m)?;
     Ok(())

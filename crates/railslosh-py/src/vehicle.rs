@@ -112,6 +112,16 @@ pub fn tank_car_parameters<'py>(
     Ok(d)
 }
 
+/// The track of a segment table, with the rails displaced by `irregularity` (a samples dict
+/// of `railslosh._core.track_irregularity`) when given.
+fn track_of(rows: Vec<Vec<f64>>, irregularity: Option<&Bound<'_, PyDict>>) -> PyResult<Arc<Track>> {
+    let track = track_from_table(rows).map_err(crate::to_py)?;
+    Ok(Arc::new(match irregularity {
+        Some(d) => track.with_irregularity(crate::irregularity::from_dict(d)?),
+        None => track,
+    }))
+}
+
 fn track_from_table(rows: Vec<Vec<f64>>) -> Result<Track, AncfError> {
     let mut pts = Vec::with_capacity(rows.len());
     for (i, r) in rows.iter().enumerate() {
@@ -179,7 +189,7 @@ fn brake_of(times: Option<Vec<f64>>, torques: Option<Vec<f64>>, scope: &str) -> 
 /// of arrays; on a failed run the dict has an `error` entry and the results so far.
 #[pyfunction]
 #[pyo3(signature = (
-    track, *, cars=1, station=50.0, speed=0.0, t_end=1.0, step=1e-3, record_every=0.01, load_filter="hat_mean",
+    track, *, irregularity=None, cars=1, station=50.0, speed=0.0, t_end=1.0, step=1e-3, record_every=0.01, load_filter="hat_mean",
     drive_speed=None, brake_times=None, brake_torques=None, brake_scope="all",
     lading_mass=0.0, lading_height=0.0, wheel_profile="s1002", wheelset_lateral_offset=0.0,
     coupler_stiffness=None, coupler_damping=None, car=None, progress=None, stream=None
@@ -188,6 +198,7 @@ fn brake_of(times: Option<Vec<f64>>, torques: Option<Vec<f64>>, scope: &str) -> 
 pub fn run_train<'py>(
     py: Python<'py>,
     track: Vec<Vec<f64>>,
+    irregularity: Option<&Bound<'py, PyDict>>,
     cars: usize,
     station: f64,
     speed: f64,
@@ -214,7 +225,7 @@ pub fn run_train<'py>(
         params.lading = Some((lading_mass, lading_height));
     }
     let brake = brake_of(brake_times, brake_torques, brake_scope)?;
-    let track = Arc::new(track_from_table(track).map_err(crate::to_py)?);
+    let track = track_of(track, irregularity)?;
     let mut sc = TrainScenario::single(params, track, station, speed, t_end);
     sc.cars = cars;
     sc.step = step;
@@ -327,7 +338,7 @@ pub fn design_brake_torque(mass: f64, v0: f64, v1: f64, duration: f64) -> PyResu
 /// damping ratio of the liquid column on the penalty wall (`WallContactLaw::with_damping_ratio`).
 #[pyfunction]
 #[pyo3(signature = (
-    track, *, cars=1, station=300.0, speed=0.0, t_end=1.0, step=4e-3, record_every=0.02, load_filter="hat_mean", snapshot_every=0.0,
+    track, *, irregularity=None, cars=1, station=300.0, speed=0.0, t_end=1.0, step=4e-3, record_every=0.02, load_filter="hat_mean", snapshot_every=0.0,
     drive_speed=None, brake_times=None, brake_torques=None, brake_scope="all", brake_factors=None,
     oil="light", fluid=None, counts=(6, 4, 2), fill=0.5, bulkheads=None, wheel_profile="s1002", car=None,
     progress=None, stream=None, wall_damping_ratio=ancf_core::contact::WALL_DAMPING_RATIO
@@ -336,6 +347,7 @@ pub fn design_brake_torque(mass: f64, v0: f64, v1: f64, duration: f64) -> PyResu
 pub fn run_fluid_train<'py>(
     py: Python<'py>,
     track: Vec<Vec<f64>>,
+    irregularity: Option<&Bound<'py, PyDict>>,
     cars: usize,
     station: f64,
     speed: f64,
@@ -372,7 +384,7 @@ pub fn run_fluid_train<'py>(
     };
     let mut cargo = FluidCargo::new(fluid, [counts.0, counts.1, counts.2], fill, bulkheads.unwrap_or_default());
     cargo.wall_damping_ratio = wall_damping_ratio;
-    let track = Arc::new(track_from_table(track).map_err(crate::to_py)?);
+    let track = track_of(track, irregularity)?;
     let mut sc = TrainScenario::single(params, track, station, speed, t_end);
     sc.cars = cars;
     sc.step = step;
@@ -523,7 +535,7 @@ fn equivalent_record_dict<'py>(py: Python<'py>, r: &EquivalentTrainRecord) -> Py
 /// liquid centre of mass in the tank frame, the slosh displacements and the model.
 #[pyfunction]
 #[pyo3(signature = (
-    track, *, cars=1, station=50.0, speed=0.0, t_end=1.0, step=1e-3, record_every=0.01, load_filter="hat_mean",
+    track, *, irregularity=None, cars=1, station=50.0, speed=0.0, t_end=1.0, step=1e-3, record_every=0.01, load_filter="hat_mean",
     drive_speed=None, brake_times=None, brake_torques=None, brake_scope="all", brake_factors=None,
     oil="light", fluid=None, fill=0.5, bulkheads=None, slosh_axis="longitudinal",
     lading_mass=0.0, lading_height=0.0, wheel_profile="s1002", car=None, progress=None, stream=None
@@ -532,6 +544,7 @@ fn equivalent_record_dict<'py>(py: Python<'py>, r: &EquivalentTrainRecord) -> Py
 pub fn run_equivalent_train<'py>(
     py: Python<'py>,
     track: Vec<Vec<f64>>,
+    irregularity: Option<&Bound<'py, PyDict>>,
     cars: usize,
     station: f64,
     speed: f64,
@@ -563,7 +576,7 @@ pub fn run_equivalent_train<'py>(
     let cargo = equivalent_cargo(oil, fluid, fill, bulkheads, slosh_axis)?;
     let modes = compute(py, || cargo.model(&params, rail_mbs::track::GRAVITY))?.modes.len();
     let brake = brake_of(brake_times, brake_torques, brake_scope)?;
-    let track = Arc::new(track_from_table(track).map_err(crate::to_py)?);
+    let track = track_of(track, irregularity)?;
     let mut sc = TrainScenario::single(params, track, station, speed, t_end);
     sc.cars = cars;
     sc.step = step;

@@ -375,7 +375,8 @@ fn contact_pair(p: &TankCarParams, track: &Arc<Track>, side: Side) -> Result<Whe
     let offset = RailGeometry::offset_for_gauge(&c.rail_profile, gauge, c.gauge_depth)
         .ok_or_else(|| invalid("contact.gauge_depth", c.gauge_depth, "within the rail profile's depth"))?;
     let straight = track.points().iter().all(|t| t.curvature == 0.0 && t.superelevation == 0.0 && t.grade == 0.0);
-    let path = if straight && track_is_at_origin(track) {
+    // the straight-rail shortcut has no irregularity: an irregular track takes the track path
+    let path = if straight && track_is_at_origin(track) && track.irregularity().is_none() {
         RailPath::Straight { inward_cant: c.straight_rail_cant }
     } else {
         RailPath::Track(track.clone())

@@ -103,7 +103,10 @@ impl RailGeometry {
             RailPath::Track(track) => {
                 let f = |s: f64| -> (Vector3<f64>, Matrix3<f64>) {
                     let fr = track.frame(s);
-                    let o = fr.origin + fr.rotation * Vector3::new(0.0, sg * self.profile_offset, self.vertical_offset);
+                    // the rail's irregularity translates its profile (track frame)
+                    let (dy, dz) = track.rail_offset(s, self.side);
+                    let o = fr.origin
+                        + fr.rotation * Vector3::new(0.0, sg * self.profile_offset + dy, self.vertical_offset + dz);
                     let r = fr.rotation * rot_x(sg * track.rail_inward_cant(s, self.side));
                     (o, r)
                 };

@@ -45,8 +45,9 @@
 //!   wide patch, as CONTACT finds for S1002/UIC60 at zero lateral shift) is represented by
 //!   two Hertzian points instead.
 //! * Rails following a [`crate::track::Track`] get the first and second derivatives of
-//!   their frame along `s` by central differences (2 cm); rails are fixed (zero
-//!   velocity; track irregularities are not modelled).
+//!   their frame along `s` by central differences (2 cm), the track's irregularity
+//!   ([`crate::track::Irregularity`], a translation of each rail's profile) included;
+//!   rails are fixed (zero velocity).
 //!
 //! # Parametrisation and frames
 //!

@@ -49,8 +49,13 @@
 //! sub-intervals no longer than [`Track::MAX_SUBINTERVAL`], tabulated once at
 //! construction; a query integrates from the nearest tabulated node.
 
+use std::sync::Arc;
+
 use nalgebra::{Matrix3, Vector3};
 use thiserror::Error;
+
+pub mod irregularity;
+pub use irregularity::{Channel, Defect, Irregularity, IrregularityError, IrregularityPsd, TrackSpectrum};
 
 pub use ancf_core::constants::{FOOT, GRAVITY, INCH, MPH};
 /// Radius, in feet, of a 1° curve with the arc definition (100 ft of arc per degree).
@@ -239,6 +244,8 @@ pub struct Track {
     /// Tabulated nodes (s, position).
     nodes_s: Vec<f64>,
     nodes_r: Vec<Vector3<f64>>,
+    /// Deviation of the rails from their design position ([`Track::with_irregularity`]).
+    irregularity: Option<Arc<Irregularity>>,
 }
 
 impl Track {
@@ -314,6 +321,7 @@ impl Track {
             heading0,
             nodes_s: Vec::new(),
             nodes_r: Vec::new(),
+            irregularity: None,
         };
         track.tabulate();
         Ok(track)
@@ -501,19 +509,39 @@ impl Track {
         TrackFrame { origin: self.position(s), rotation: Matrix3::from_columns(&[t, l, u]) }
     }
 
-    /// Point of the gauge line of one rail at `s` (centreline ± gauge/2 along the
-    /// track-frame lateral axis).
-    pub fn rail_point(&self, s: f64, side: Side) -> Vector3<f64> {
-        let f = self.frame(s);
-        f.origin + f.lateral() * (side.sign() * 0.5 * self.gauge)
+    /// The same track with the rails displaced by `irregularity` (module
+    /// [`irregularity`]); the centreline and its frames stay the design ones.
+    pub fn with_irregularity(mut self, irregularity: Irregularity) -> Self {
+        self.irregularity = Some(Arc::new(irregularity));
+        self
     }
 
-    /// Rail profile frame at `s`: origin at the rail gauge line ([`Track::rail_point`])
-    /// plus `offset` (given in the track frame), axes rotated about the tangent by the
-    /// inward cant (`+inward` for the left rail, `−inward` for the right rail).
+    /// The rails' irregularity, if any.
+    pub fn irregularity(&self) -> Option<&Irregularity> {
+        self.irregularity.as_deref()
+    }
+
+    /// Offset of one rail from its design position at `s`, (lateral, vertical) in the
+    /// track frame, m: zero on a perfect track ([`Irregularity::rail_offset`]).
+    pub fn rail_offset(&self, s: f64, side: Side) -> (f64, f64) {
+        self.irregularity.as_ref().map_or((0.0, 0.0), |irr| irr.rail_offset(s, side))
+    }
+
+    /// Point of the gauge line of one rail at `s` (centreline ± gauge/2 along the
+    /// track-frame lateral axis, plus the rail's irregularity offset).
+    pub fn rail_point(&self, s: f64, side: Side) -> Vector3<f64> {
+        let f = self.frame(s);
+        let (dy, dz) = self.rail_offset(s, side);
+        f.origin + f.lateral() * (side.sign() * 0.5 * self.gauge + dy) + f.up() * dz
+    }
+
+    /// Rail profile frame at `s`: origin at the rail gauge line ([`Track::rail_point`],
+    /// irregularity included) plus `offset` (given in the track frame), axes rotated about
+    /// the tangent by the inward cant (`+inward` for the left rail, `−inward` for the right
+    /// rail).
     pub fn rail_frame(&self, s: f64, side: Side, offset: Vector3<f64>) -> TrackFrame {
         let f = self.frame(s);
-        let base = f.origin + f.lateral() * (side.sign() * 0.5 * self.gauge) + f.rotation * offset;
+        let base = self.rail_point(s, side) + f.rotation * offset;
         let ang = side.sign() * self.rail_inward_cant(s, side);
         let (sa, ca) = ang.sin_cos();
         let rx = Matrix3::new(1.0, 0.0, 0.0, 0.0, ca, -sa, 0.0, sa, ca);
