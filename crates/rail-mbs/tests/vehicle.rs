@@ -93,3 +93,32 @@ fn coupler_faces_stay_at_the_coupler_height_with_rigid_lading_off_the_axis() {
         );
     }
 }
+
+#[test]
+fn the_recorded_car_acceleration_is_the_derivative_of_the_car_speed() {
+    // A braked single car on tangent track: its longitudinal car-body acceleration (a load
+    // channel, hat-mean filtered) equals d(speed)/dt from the recorded speeds, the lateral one
+    // stays zero, and the vertical one is zero on average (the car neither rises nor sinks).
+    let v = 30.0 / 3.6;
+    let mut sc = TrainScenario::single(TankCarParams::standard().unwrap(), tangent(), 100.0, v, 2.0);
+    sc.record_every = 0.01;
+    let torque = Table::new("brake", vec![0.0, 0.3, 2.0], vec![0.0, 8000.0, 8000.0]).unwrap();
+    sc.brake = Some((torque, BrakeScope::AllCars));
+    let rec = run_train(&sc).unwrap().unwrap();
+    let n = rec.t.len();
+    assert_eq!(rec.car_acceleration.len(), n);
+    let mut worst: f64 = 0.0;
+    let mut decel_seen: f64 = 0.0;
+    for i in (n / 2)..n - 1 {
+        let dvdt = (rec.tank_speed[i + 1][0] - rec.tank_speed[i - 1][0]) / (rec.t[i + 1] - rec.t[i - 1]);
+        let ax = rec.car_acceleration[i][0][0];
+        worst = worst.max((ax - dvdt).abs());
+        decel_seen = decel_seen.min(ax);
+        assert!(rec.car_acceleration[i][0][1].abs() < 1e-6, "lateral {:?}", rec.car_acceleration[i]);
+    }
+    let mean_z: f64 = rec.car_acceleration[n / 2..].iter().map(|a| a[0][2]).sum::<f64>() / (n - n / 2) as f64;
+    println!("braking: car acceleration x down to {decel_seen:.4} m/s², |a_x − dv/dt| ≤ {worst:.2e}, mean a_z {mean_z:.2e}");
+    assert!(decel_seen < -0.1, "the brake decelerates the car: {decel_seen}");
+    assert!(worst < 0.02 * decel_seen.abs(), "{worst} vs {decel_seen}");
+    assert!(mean_z.abs() < 1e-3, "{mean_z}");
+}

@@ -158,6 +158,8 @@ fn record_dict<'py>(py: Python<'py>, r: &TrainRecord) -> PyResult<Bound<'py, PyD
     let ncar = r.tank_station.first().map_or(0, |x| x.len());
     d.set_item("tank_station", arr(py, flat2(&r.tank_station), &[nt, ncar])?)?;
     d.set_item("tank_speed", arr(py, flat2(&r.tank_speed), &[nt, ncar])?)?;
+    let acc: Vec<f64> = r.car_acceleration.iter().flat_map(|s| s.iter().flat_map(|c| c.iter().copied())).collect();
+    d.set_item("car_acceleration", arr(py, acc, &[nt, ncar, 3])?)?;
     d.set_item("static_wheel_load", r.static_wheel_load)?;
     d.set_item("dof", r.dof)?;
     let s = PyDict::new(py);

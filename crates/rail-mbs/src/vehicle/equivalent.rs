@@ -761,9 +761,17 @@ impl TrainRun for EquivalentRun<'_> {
         rec: &mut EquivalentTrainRecord,
         full: bool,
     ) -> Result<(), IntegratorError> {
-        let (t, q, v) = (hht.t(), hht.q().to_vec(), hht.v().to_vec());
+        let (t, q, v, a) = (hht.t(), hht.q().to_vec(), hht.v().to_vec(), hht.a().to_vec());
         let mb = hht.system_observed();
-        record_sample(mb, (t, &q, &v), &self.sc.track, &self.cars, &self.couplers, &mut self.hints, &mut rec.train)?;
+        record_sample(
+            mb,
+            (t, &q, &v, &a),
+            &self.sc.track,
+            &self.cars,
+            &self.couplers,
+            &mut self.hints,
+            &mut rec.train,
+        )?;
         if full {
             let parts = (self.cars.as_slice(), self.slosh.as_slice(), &self.model, self.tank_origin_height);
             record_equivalent(hht.system(), parts, &q, rec);

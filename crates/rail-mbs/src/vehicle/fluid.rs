@@ -889,9 +889,10 @@ impl TrainRun for FluidRun<'_> {
         full: bool,
     ) -> Result<(), IntegratorError> {
         let (t, q, v) = (hht.t(), hht.q().to_vec(), hht.v().to_vec());
+        let a = hht.a()[..self.nr].to_vec();
         let (nr, sc) = (self.nr, self.sc);
         let sys = hht.system_observed();
-        let state = (t, &q[..nr], &v[..nr]);
+        let state = (t, &q[..nr], &v[..nr], &a[..]);
         record_sample(&mut sys.mb, state, &sc.track, &self.cars, &self.couplers, &mut self.hints, &mut rec.train)?;
         record_fluid(hht.system(), &q, &v, rec);
         if full && sc.snapshot_every > 0.0 {

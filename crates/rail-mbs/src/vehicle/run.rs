@@ -142,6 +142,11 @@ pub struct TrainRecord {
     pub tank_station: Vec<Vec<f64>>,
     /// Tank speed, m/s: `[sample][car]`.
     pub tank_speed: Vec<Vec<f64>>,
+    /// Acceleration of each car body's reference point (the tank centre), in the car body's
+    /// axes (x forward, y left, z up; gravity not included), m/s²: `[sample][car][x, y, z]`.
+    /// A load channel: recorded through the [`LoadFilter`] like the wheel loads, so that the
+    /// ride indices see no aliasing.
+    pub car_acceleration: Vec<Vec<[f64; 3]>>,
     /// Static wheel load on level track, N.
     pub static_wheel_load: f64,
     /// Newton iterations, steps, rejected steps, Jacobian evaluations.
@@ -193,6 +198,11 @@ impl TrainRecord {
         c.extend((0..couplers).map(|k| format!("coupler_force[{k}]")));
         c.extend((0..cars).map(|k| format!("tank_station[{k}]")));
         c.extend((0..cars).map(|k| format!("tank_speed[{k}]")));
+        for k in 0..cars {
+            for axis in ["x", "y", "z"] {
+                c.push(format!("car_acceleration[{k}].{axis}"));
+            }
+        }
         c
     }
 
@@ -205,15 +215,18 @@ impl TrainRecord {
         r.extend(&self.coupler_force[i]);
         r.extend(&self.tank_station[i]);
         r.extend(&self.tank_speed[i]);
+        r.extend(self.car_acceleration[i].iter().flatten());
         r
     }
 
     /// The load channels of sample `i` (filtered by [`LoadFilter`]): wheel `Q` and `Y` per
-    /// wheelset and side, then the coupler forces, appended to `out`.
+    /// wheelset and side, the coupler forces, then the car-body accelerations, appended to
+    /// `out`.
     pub fn loads_into(&self, i: usize, out: &mut Vec<f64>) {
         out.extend(self.wheel_vertical[i].iter().flatten());
         out.extend(self.wheel_lateral[i].iter().flatten());
         out.extend(&self.coupler_force[i]);
+        out.extend(self.car_acceleration[i].iter().flatten());
     }
 
     /// Replaces the load channels of sample `i` by `loads` (layout of
@@ -227,7 +240,7 @@ impl TrainRecord {
                 n += 1;
             }
         }
-        for x in self.coupler_force[i].iter_mut() {
+        for x in self.coupler_force[i].iter_mut().chain(self.car_acceleration[i].iter_mut().flatten()) {
             *x = it.next().unwrap_or(*x);
             n += 1;
         }
@@ -243,6 +256,7 @@ impl TrainRecord {
         self.coupler_force.clear();
         self.tank_station.clear();
         self.tank_speed.clear();
+        self.car_acceleration.clear();
     }
 
     /// Mean over samples with `t ≥ t0` of the vertical load of `(wheelset, side)`.
@@ -320,10 +334,11 @@ pub fn build_train(sc: &TrainScenario) -> Result<(Multibody, Vec<CarBodies>, Vec
 }
 
 /// Records one sample of the rigid vehicle state (wheel loads, couplers, tanks) of a
-/// multibody system at `(t, q, v)` (rigid coordinates only).
+/// multibody system at `(t, q, v, a)` (rigid coordinates only; `a` the integrator's
+/// accelerations).
 pub(crate) fn record_sample(
     mb: &mut Multibody,
-    (t, q, v): (f64, &[f64], &[f64]),
+    (t, q, v, a): (f64, &[f64], &[f64], &[f64]),
     track: &Track,
     cars: &[CarBodies],
     couplers: &[usize],
@@ -362,13 +377,19 @@ pub(crate) fn record_sample(
     rec.coupler_force.push(couplers.iter().map(|&c| forces[c]).collect());
     let mut st = Vec::new();
     let mut sp = Vec::new();
+    let mut acc = Vec::new();
     for car in cars {
         let s = mb.state(Some(car.tank), q, v);
         st.push(track.project(&s.position, Some(car.station)).map_or(f64::NAN, |p| p.s));
         sp.push(s.velocity.norm());
+        // the body state with the accelerations in place of the velocities: its "velocity"
+        // is the origin's acceleration r̈ (the translational coordinates are the origin's)
+        let r_dd = mb.state(Some(car.tank), q, a).velocity;
+        acc.push((s.rotation.transpose() * r_dd).into());
     }
     rec.tank_station.push(st);
     rec.tank_speed.push(sp);
+    rec.car_acceleration.push(acc);
     Ok(())
 }
 
@@ -688,10 +709,10 @@ impl TrainRun for RigidRun<'_> {
         rec: &mut TrainRecord,
         _full: bool,
     ) -> Result<(), IntegratorError> {
-        let (t, q, v) = (hht.t(), hht.q().to_vec(), hht.v().to_vec());
+        let (t, q, v, a) = (hht.t(), hht.q().to_vec(), hht.v().to_vec(), hht.a().to_vec());
         record_sample(
             hht.system_observed(),
-            (t, &q, &v),
+            (t, &q, &v, &a),
             &self.sc.track,
             &self.cars,
             &self.couplers,
