@@ -117,8 +117,32 @@ fn the_recorded_car_acceleration_is_the_derivative_of_the_car_speed() {
         assert!(rec.car_acceleration[i][0][1].abs() < 1e-6, "lateral {:?}", rec.car_acceleration[i]);
     }
     let mean_z: f64 = rec.car_acceleration[n / 2..].iter().map(|a| a[0][2]).sum::<f64>() / (n - n / 2) as f64;
-    println!("braking: car acceleration x down to {decel_seen:.4} m/s², |a_x − dv/dt| ≤ {worst:.2e}, mean a_z {mean_z:.2e}");
+    println!(
+        "braking: car acceleration x down to {decel_seen:.4} m/s², |a_x − dv/dt| ≤ {worst:.2e}, mean a_z {mean_z:.2e}"
+    );
     assert!(decel_seen < -0.1, "the brake decelerates the car: {decel_seen}");
     assert!(worst < 0.02 * decel_seen.abs(), "{worst} vs {decel_seen}");
     assert!(mean_z.abs() < 1e-3, "{mean_z}");
+}
+
+#[test]
+fn rigid_lading_spread_over_a_length_carries_its_rod_inertia_in_pitch_and_yaw() {
+    let (m, h, l) = (60_000.0, -0.3, 11.7);
+    let inertia = |length: f64| {
+        let mut p = TankCarParams::standard().unwrap();
+        p.lading = Some((m, h));
+        p.lading_length = length;
+        let sc = TrainScenario::single(p, tangent(), 100.0, 0.0, 1.0);
+        let (mb, cars, _) = build_train(&sc).unwrap();
+        mb.bodies()[cars[0].tank.0].inertia
+    };
+    let (point, spread) = (inertia(0.0), inertia(l));
+    let rod = m * l * l / 12.0;
+    assert!((spread[(0, 0)] - point[(0, 0)]).abs() < 1e-6, "roll unchanged");
+    assert!((spread[(1, 1)] - point[(1, 1)] - rod).abs() < 1e-6 * rod, "pitch + m L²/12");
+    assert!((spread[(2, 2)] - point[(2, 2)] - rod).abs() < 1e-6 * rod, "yaw + m L²/12");
+    let mut p = TankCarParams::standard().unwrap();
+    p.lading_length = -1.0;
+    let e = p.validate().unwrap_err().to_string();
+    assert!(e.contains("`lading_length` = -1"), "{e}");
 }

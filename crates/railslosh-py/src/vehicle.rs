@@ -28,6 +28,7 @@ const FIELDS: &[Field] = &[
     ("tank_radius", |p| p.tank_radius, |p, v| p.tank_radius = v),
     ("tank_axis_height", |p| p.tank_axis_height, |p, v| p.tank_axis_height = v),
     ("tank_mass", |p| p.tank.mass, |p, v| p.tank.mass = v),
+    ("lading_length", |p| p.lading_length, |p, v| p.lading_length = v),
     ("stub_sill_mass", |p| p.stub_sill.mass, |p, v| p.stub_sill.mass = v),
     ("truck_centers", |p| p.truck_centers, |p, v| p.truck_centers = v),
     ("wheelbase", |p| p.wheelbase, |p, v| p.wheelbase = v),

@@ -13,11 +13,12 @@ from typing import Any
 import numpy as np
 
 from railslosh import rail, vehicle
+from railslosh.irregularity import Irregularity, from_spec
 from railslosh.limits import Limit, invalid, missing
 from railslosh.scene.common import Outputs, meta, settle_time, vehicle_outputs
 from railslosh.scene.fluid import FluidSpec, vehicle_fluid
 from railslosh.scene.schema import Section, increasing, number_list, scoped, table, unknown_sections
-from railslosh.scene.track import track
+from railslosh.scene.track import irregularity_spec, irregularity_table, track
 
 _BRAKE_TIME = Limit(0.0, 1e4, "s", "a time")
 _BRAKE_TORQUE = Limit(0.0, 1e5, "N m", "a torque")
@@ -83,6 +84,9 @@ class Scene:
     brake_design: Mapping[str, float] | None = None
     """``{"v1": m/s, "duration": s}`` when ``[brake] design = true`` (times/torques then computed)."""
     outputs: Outputs = field(default_factory=lambda: Outputs())
+    irregularity: Mapping[str, Any] | None = None
+    """``[track.irregularities]`` as given, checked (SI units; a scene file's relative ``file`` made
+    absolute); ``None`` = perfect track. :meth:`irregularity_spec` fills in the defaults for this train."""
 
     @property
     def kind(self) -> str:
@@ -92,6 +96,28 @@ class Scene:
     def track(self) -> rail.Track:
         """The track as a :class:`railslosh.rail.Track`."""
         return rail.Track.from_table(np.asarray(self.track_rows, dtype=float))
+
+    def irregularity_spec(self) -> dict[str, Any] | None:
+        """The track irregularity of ``[track.irregularities]`` for this train, defaults filled in (the
+        spec of :func:`railslosh.irregularity.from_spec`: ``start`` 10 m ahead of the leading wheelset
+        at t = 0, ``length`` covering the run, ...); ``None`` on perfect track."""
+        if self.irregularity is None:
+            return None
+        return irregularity_spec(
+            self.irregularity,
+            cars=self.cars,
+            station=self.station,
+            car=self.car,
+            speed=max(self.speed, self.drive if not isinstance(self.drive, bool) else 0.0),
+            t_end=self.t_end,
+        )
+
+    def track_irregularity(self) -> Irregularity | None:
+        """The :class:`railslosh.irregularity.Irregularity` of :meth:`irregularity_spec` (``None`` on
+        perfect track): generated (a fraction of a second for a few hundred metres; the cost grows
+        with the length squared) or read from its file."""
+        spec = self.irregularity_spec()
+        return None if spec is None else from_spec(spec)
 
     def run_kwargs(self) -> dict[str, Any]:
         """Keyword arguments of :func:`railslosh.vehicle.run` (after the track)."""
@@ -116,6 +142,7 @@ class Scene:
             "coupler_stiffness": self.coupler_stiffness,
             "coupler_damping": self.coupler_damping,
             "car": dict(self.car) or None,
+            "irregularity": self.track_irregularity(),
         }
 
     def fluid_kwargs(self) -> dict[str, Any]:
@@ -149,7 +176,8 @@ class Scene:
 
     def rigid_kwargs(self) -> dict[str, Any]:
         """Keyword arguments of :func:`railslosh.vehicle.run` (after the track) with the liquid as rigid
-        lading: its mass at its rest centroid height."""
+        lading: its mass at its rest centroid height, spread over the compartments' length (its pitch and
+        yaw inertia, ``car.lading_length``, as the equivalent model's fixed masses carry theirs)."""
         if self.fluid is None:
             return self.run_kwargs()
         f = self.fluid
@@ -157,6 +185,7 @@ class Scene:
         kw = self.run_kwargs()
         kw["lading_mass"] = f.mass({**car_defaults(), **self.car})
         kw["lading_height"] = float(geo["centroid"][2])
+        kw["car"] = {**self.car, "lading_length": float(sum(m["compartment_length"] for m in geo["modes"]))}
         return kw
 
     def tank_radius(self) -> float:
@@ -190,6 +219,11 @@ def _to_dict(sc: Scene) -> dict[str, Any]:
     if sc.coupler_damping is not None:
         train["coupler_damping"] = sc.coupler_damping
     d: dict[str, Any] = {"track": {"rows": [list(r) for r in sc.track_rows]}, "train": train}
+    if sc.irregularity is not None:
+        d["track"]["irregularities"] = {
+            k: [dict(x) for x in v] if k == "defects" else (list(v) if isinstance(v, list | tuple) else v)
+            for k, v in sc.irregularity.items()
+        }
     if sc.brake_times is not None and sc.brake_torques is not None:
         d["brake"] = {"times": list(sc.brake_times), "torques": list(sc.brake_torques), "scope": sc.brake_scope}
     if sc.lading_mass or sc.lading_height:
@@ -306,10 +340,14 @@ def scene_from_dict(data: Mapping[str, Any]) -> Scene:
     if "track" not in data:
         raise missing("track", "a [track] section (preset, rows or us_rows)")
     rows, source = track(data)
+    irregular = irregularity_table(data)
     # [car] first: the train and lading checks use its geometry.
     car, wheel_profile = _car(data)
     params = {**car_defaults(), **car}
     tr = _train(data, rows, params)
+    if irregular is not None:  # checked against the train (where it stands, how far it runs)
+        speed = max(tr["speed"], tr["drive"] if not isinstance(tr["drive"], bool) else 0.0)
+        irregularity_spec(irregular, cars=tr["cars"], station=tr["station"], car=car, speed=speed, t_end=tr["t_end"])
     br = _brake(data, tr["speed"], tr["cars"])
     lading_mass, lading_height = _lading(data, params["tank_radius"])
     name, description = meta("vehicle", data)
@@ -361,4 +399,5 @@ def scene_from_dict(data: Mapping[str, Any]) -> Scene:
         brake_factors=br["factors"],
         brake_design=br["design"],
         outputs=outputs,
+        irregularity=irregular,
     )

@@ -617,6 +617,12 @@ pub fn build_equivalent_train(sc: &TrainScenario, cargo: &EquivalentCargo) -> Re
     let mut sc2 = sc.clone();
     let (ml, hl) = model.lading(sc.car.lading);
     sc2.car.lading = Some((ml, hl));
+    // the car's own lading keeps its spread (its rod inertia); the fixed masses add theirs
+    // below, per compartment
+    let own = sc.car.lading.map_or(0.0, |l| l.0) * sc.car.lading_length * sc.car.lading_length / 12.0;
+    sc2.car.lading_length = 0.0;
+    sc2.car.tank.inertia[1] += own;
+    sc2.car.tank.inertia[2] += own;
     sc2.car.carried_mass += model.sloshing_mass();
     for (m, c) in model.modes.iter().zip(&model.compartments) {
         let pitch = m.fixed_mass * (m.fixed_position[0].powi(2) + c.length * c.length / 12.0);

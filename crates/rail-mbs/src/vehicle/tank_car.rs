@@ -102,6 +102,10 @@ pub struct TankCarParams {
     /// Rigid lading added to the tank body (kg, centre height above the tank axis, m).
     /// Default none (the fluid is modelled separately).
     pub lading: Option<(f64, f64)>,
+    /// Length along the tank axis over which the rigid lading is spread uniformly, centred
+    /// on the tank's mid-length, m: it adds `m L²/12` to the tank's pitch and yaw inertia
+    /// (a liquid frozen in the tank fills its whole length). Default 0: a point mass.
+    pub lading_length: f64,
     /// Mass carried in the tank but modelled as separate bodies (the ANCF fluid), kg: it
     /// counts in the suspension preloads and the static wheel loads. Default 0.
     pub carried_mass: f64,
@@ -167,6 +171,7 @@ impl TankCarParams {
             tank_axis_height: 2.35,
             tank: shell,
             lading: None,
+            lading_length: 0.0,
             carried_mass: 0.0,
             stub_sill: BodyMass { mass: 1200.0, inertia: [60.0, 250.0, 250.0] },
             truck_centers: 9.0,
@@ -249,6 +254,16 @@ impl TankCarParams {
             && !(m.is_finite() && m >= 0.0)
         {
             return Err(invalid("lading mass", m, "finite, >= 0 kg"));
+        }
+        if !(self.lading_length.is_finite()
+            && self.lading_length >= 0.0
+            && self.lading_length <= 2.0 * self.tank_length)
+        {
+            return Err(invalid(
+                "lading_length",
+                self.lading_length,
+                &format!("finite, 0 to twice the tank length ({} m)", 2.0 * self.tank_length),
+            ));
         }
         for (name, s) in [("primary", self.primary), ("journal", self.journal), ("secondary", self.secondary)] {
             for (k, v) in s.stiffness.iter().chain(&s.damping).enumerate() {
@@ -471,8 +486,12 @@ pub fn add_tank_car(
     let tank_mass = BodyMass {
         mass: p.tank.mass + p.lading.map_or(0.0, |l| l.0),
         inertia: match p.lading {
-            // Lading as a point mass at its height above the tank axis (parallel axes).
-            Some((m, h)) => [p.tank.inertia[0] + m * h * h, p.tank.inertia[1] + m * h * h, p.tank.inertia[2]],
+            // Lading at its height above the tank axis (parallel axes), spread uniformly over
+            // `lading_length` along the axis (a rod: m L²/12 in pitch and yaw).
+            Some((m, h)) => {
+                let rod = m * p.lading_length * p.lading_length / 12.0;
+                [p.tank.inertia[0] + m * h * h, p.tank.inertia[1] + m * h * h + rod, p.tank.inertia[2] + rod]
+            }
             None => p.tank.inertia,
         },
     };
