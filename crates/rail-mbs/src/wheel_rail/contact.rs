@@ -641,7 +641,15 @@ impl WheelRailContact {
                 Some(g) => g,
                 None => {
                     let q = self.refine_scan(pose, s0, ulo, uhi);
-                    self.geometry_at(pose, q, ContactMethod::ScanFallback)
+                    // Newton once more from the refined scan point: when it converges the
+                    // point is exact (and the same whichever start the search had), the scan
+                    // point only approximate
+                    self.newton(pose, q)
+                        .ok()
+                        .filter(|q| self.in_domain(q) && (q[2] - seed[2]).abs() < 5e-3)
+                        .map(|q| self.geometry_at(pose, q, ContactMethod::Newton))
+                        .filter(|g| g.curvature_x > 0.0 && g.curvature_y > 0.0)
+                        .unwrap_or_else(|| self.geometry_at(pose, q, ContactMethod::ScanFallback))
                 }
             };
             out.push(g);

@@ -1,0 +1,159 @@
+//! Mirror symmetry of the wheel/rail contact (issue 21): with the same (symmetric) profiles on
+//! both sides, the right wheel at lateral shift y, yaw ψ and roll φ is the mirror image of the
+//! left wheel at −y, −ψ, −φ. The mapping, written once: the reflection M = diag(1, −1, 1) of the
+//! track's lateral axis maps positions and forces as x → M x, rotations as R → M R M, the
+//! angular velocity (a pseudovector) as ω → −M ω, and moments (pseudovectors) as m → −M m.
+
+use nalgebra::{Matrix3, Vector3};
+use rail_mbs::profile::{s1002_wheel, uic60_rail};
+use rail_mbs::track::Side;
+use rail_mbs::wheel_rail::{RailGeometry, RailPath, WheelGeometry, WheelPose, WheelRailContact};
+
+fn contact(side: Side) -> WheelRailContact {
+    let rail = uic60_rail(2e-4).unwrap();
+    let offset = RailGeometry::offset_for_gauge(&rail, 1.435, 0.014).unwrap();
+    let mut c = WheelRailContact::new(
+        WheelGeometry { profile: s1002_wheel(2e-4).unwrap(), nominal_radius: 0.46, profile_offset: 0.75, side },
+        RailGeometry {
+            profile: rail,
+            side,
+            profile_offset: offset,
+            vertical_offset: 0.0,
+            path: RailPath::Straight { inward_cant: 1.0 / 40.0 },
+        },
+    );
+    c.settings.always_scan = true; // no warm start: each pose is found from scratch
+    c
+}
+
+fn rot(yaw: f64, roll: f64) -> Matrix3<f64> {
+    let (sz, cz) = yaw.sin_cos();
+    let (sx, cx) = roll.sin_cos();
+    Matrix3::new(cz, -sz, 0.0, sz, cz, 0.0, 0.0, 0.0, 1.0) * Matrix3::new(1.0, 0.0, 0.0, 0.0, cx, -sx, 0.0, sx, cx)
+}
+
+/// The mirror image of a pose (module docs).
+fn mirror(p: &WheelPose) -> WheelPose {
+    let m = Matrix3::from_diagonal(&Vector3::new(1.0, -1.0, 1.0));
+    WheelPose {
+        position: m * p.position,
+        rotation: m * p.rotation * m,
+        velocity: m * p.velocity,
+        angular_velocity: -(m * p.angular_velocity),
+    }
+}
+
+/// Contact points that the search could only approximate (scan fall-backs).
+static FALLBACKS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
+/// Total force on the wheel and moment about the wheelset centre (global), and the normal
+/// forces, sorted by contact-point lateral position.
+fn resultant(c: &mut WheelRailContact, pose: &WheelPose) -> (Vector3<f64>, Vector3<f64>, Vec<f64>) {
+    c.reset(); // a pure function of the pose: no previous solution as a starting guess
+    let pts = c.evaluate(pose).unwrap();
+    FALLBACKS.fetch_add(
+        pts.iter().filter(|p| p.geometry.method != rail_mbs::wheel_rail::ContactMethod::Newton).count(),
+        std::sync::atomic::Ordering::Relaxed,
+    );
+    let f = pts.iter().map(|p| p.force_on_wheel()).sum();
+    let m = pts.iter().map(|p| p.moment_on_wheel(&pose.position)).sum();
+    let mut n: Vec<(f64, f64)> = pts.iter().map(|p| (p.point().y.abs(), p.normal_force)).collect();
+    n.sort_by(|a, b| a.0.total_cmp(&b.0));
+    (f, m, n.into_iter().map(|x| x.1).collect())
+}
+
+/// The wheel-centre height at which the vertical contact force is `fz` (bisection).
+fn height_for_load(c: &mut WheelRailContact, pose: &WheelPose, fz: f64) -> f64 {
+    let mut p = *pose;
+    let mut f = |z: f64| {
+        p.position.z = z;
+        c.evaluate(&p).unwrap().iter().map(|q| q.force_on_wheel().z).sum::<f64>()
+    };
+    let (mut lo, mut hi) = (pose.position.z - 0.02, pose.position.z + 0.02);
+    assert!(f(lo) > fz && f(hi) < fz, "bracket");
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if f(mid) > fz { lo = mid } else { hi = mid }
+    }
+    0.5 * (lo + hi)
+}
+
+#[test]
+fn the_right_wheel_is_the_mirror_image_of_the_left_wheel_over_a_sweep_of_shifts() {
+    let (mut left, mut right) = (contact(Side::Left), contact(Side::Right));
+    let m = Matrix3::from_diagonal(&Vector3::new(1.0, -1.0, 1.0));
+    let (v, r0) = (20.0, 0.46);
+    let mut worst: f64 = 0.0;
+    let mut cases = 0;
+    let mut counts = std::collections::BTreeMap::new();
+    for &(yaw, roll) in &[(0.0, 0.0), (0.004, 0.0), (-0.003, 0.0015)] {
+        for k in 0..=200 {
+            // wheelset shift −10 … +10 mm (both flange contacts and the jumps towards them)
+            let y = -0.010 + 1e-4 * k as f64;
+            let mut pose = WheelPose {
+                position: Vector3::new(5.0, y, r0),
+                rotation: rot(yaw, roll),
+                velocity: Vector3::new(v, 0.05, 0.0),
+                angular_velocity: Vector3::new(0.0, v / r0 * 1.001, 0.0),
+            };
+            // the left wheel carrying 60 kN (the mirrored right wheel is then at that height too)
+            pose.position.z = height_for_load(&mut left, &pose, 6e4);
+            let (fl, ml, nl) = resultant(&mut left, &pose);
+            let mp = mirror(&pose);
+            let (fr, mr, nr) = resultant(&mut right, &mp);
+            *counts.entry(nl.len()).or_insert(0) += 1;
+            assert!(!nl.is_empty(), "the wheel touches the rail");
+            assert_eq!(nl.len(), nr.len(), "contact-point count at y = {y}, yaw {yaw}, roll {roll}");
+            let scale = fl.norm().max(1.0);
+            let ef = (fr - m * fl).norm() / scale;
+            let em = (mr + m * ml).norm() / (ml.norm().max(1.0));
+            let en = nl.iter().zip(&nr).map(|(a, b)| (a - b).abs() / scale).fold(0.0, f64::max);
+            worst = worst.max(ef).max(em).max(en);
+            assert!(
+                ef < 1e-9 && em < 1e-9 && en < 1e-9,
+                "y = {y}, yaw {yaw}, roll {roll}: force {ef:e}, moment {em:e}, normal {en:e}"
+            );
+            cases += 1;
+        }
+    }
+    let fallbacks = FALLBACKS.load(std::sync::atomic::Ordering::Relaxed);
+    println!(
+        "{cases} mirrored poses, contact-point counts {counts:?}, worst relative difference {worst:.2e}, \
+         {fallbacks} scan fall-back points (both wheels)"
+    );
+}
+
+#[test]
+#[ignore = "issue 21 open: at y = -7.1 mm (flange root) the warm-started search finds a near-conformal \
+            Newton point (N = 163 kN, relative curvature 0.035 1/m) that a fresh search misses (scan \
+            fall-back 1.9 mm away, N = 54.5 kN); docs/validation.md, Wheel/rail contact"]
+fn the_contact_of_a_pose_does_not_depend_on_the_search_history() {
+    // The search starts Newton from earlier solutions when they lie near a scan seed; the
+    // points it returns must still be those of a fresh search (same method, same point).
+    let mut warm = contact(Side::Right);
+    let mut fresh = contact(Side::Right);
+    let (v, r0) = (20.0, 0.46);
+    let (mut worst, mut fallbacks) = (0.0f64, 0);
+    for k in 0..=200 {
+        let y = 0.010 - 1e-4 * k as f64;
+        let mut pose = WheelPose {
+            position: Vector3::new(5.0, y, r0),
+            rotation: rot(0.0, 0.0),
+            velocity: Vector3::new(v, 0.05, 0.0),
+            angular_velocity: Vector3::new(0.0, v / r0 * 1.001, 0.0),
+        };
+        pose.position.z = height_for_load(&mut warm, &pose, 6e4); // leaves a history in `warm`
+        let a = warm.evaluate(&pose).unwrap();
+        fresh.reset();
+        let b = fresh.evaluate(&pose).unwrap();
+        assert_eq!(a.len(), b.len(), "y = {y}");
+        for (p, q) in a.iter().zip(&b) {
+            assert_eq!(p.geometry.method, q.geometry.method, "y = {y}");
+            fallbacks += usize::from(p.geometry.method != rail_mbs::wheel_rail::ContactMethod::Newton);
+            worst = worst.max((p.normal_force - q.normal_force).abs() / q.normal_force.max(1.0));
+            worst = worst.max((p.point() - q.point()).norm() / 1e-3);
+        }
+    }
+    println!("history against fresh search: worst relative difference {worst:.2e}, {fallbacks} scan fall-backs");
+    assert!(worst < 1e-9, "{worst}");
+}
