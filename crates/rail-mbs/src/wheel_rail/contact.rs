@@ -313,6 +313,9 @@ pub struct WheelRailContact {
     pub rail_material: Material,
     /// Friction coefficient.
     pub friction: f64,
+    /// Friction over the rail profile and along the track; when set it replaces `friction`
+    /// at every contact point, each point taking the μ of its own location.
+    pub friction_map: Option<std::sync::Arc<super::FrictionMap>>,
     /// Creep law.
     pub creep_model: CreepModel,
     /// Hunt–Crossley damping coefficient `d` in `f_n = K_h δ^{3/2}(1 + d δ̇)`, s/m.
@@ -348,6 +351,7 @@ impl WheelRailContact {
             wheel_material: Material::steel(),
             rail_material: Material::steel(),
             friction: 0.3,
+            friction_map: None,
             creep_model: CreepModel::ShenHedrickElkins,
             damping: 0.0,
             settings: ContactSettings::default(),
@@ -681,6 +685,13 @@ impl WheelRailContact {
         v.sort_by(|a, b| a.params[2].total_cmp(&b.params[2]));
     }
 
+    /// The friction coefficient at contact parameters `q` (`q[0]` the distance along the
+    /// rail, `q[1]` the rail profile's lateral coordinate): the map's when set, else
+    /// `friction`.
+    pub fn friction_at(&self, q: &[f64; 4]) -> f64 {
+        self.friction_map.as_ref().map_or(self.friction, |m| m.mu(q[0], q[1]))
+    }
+
     /// Contact points in contact (`δ > 0`) with normal and creep forces.
     pub fn evaluate(&mut self, pose: &WheelPose) -> Result<Vec<ContactPoint>, ContactError> {
         self.evaluate_cached(pose).map(<[ContactPoint]>::to_vec)
@@ -736,7 +747,7 @@ impl WheelRailContact {
                 spin: pose.angular_velocity.dot(&g.normal) / speed,
             };
             let (a, b) = hertz.semi_axes(fn_);
-            let creep = creep_forces(self.creep_model, &creepages, a, b, fn_, self.friction, g_mod, nu);
+            let creep = creep_forces(self.creep_model, &creepages, a, b, fn_, self.friction_at(&g.params), g_mod, nu);
             out.push(ContactPoint {
                 geometry: g,
                 hertz,

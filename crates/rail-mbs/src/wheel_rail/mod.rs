@@ -68,6 +68,7 @@
 
 pub mod contact;
 pub mod creep;
+pub mod friction;
 pub mod hertz;
 pub mod static_load;
 pub mod validate;
@@ -79,6 +80,7 @@ pub use contact::{
 pub use creep::{
     CreepForces, CreepModel, Creepages, KalkerCoefficients, creep_forces, kalker_coefficients, linear_coefficients,
 };
+pub use friction::FrictionMap;
 pub use hertz::{HertzConstants, Material, combined_modulus, elliptic_ke};
 pub use static_load::{LoadedContact, VerticalTarget, WheelState, apply_creepages, solve_vertical};
 

@@ -226,6 +226,15 @@ pub fn apply_creepages(contact: &WheelRailContact, points: &mut [ContactPoint], 
     for p in points {
         let (a, b) = p.semi_axes;
         p.creepages = *creepages;
-        p.creep = creep_forces(contact.creep_model, creepages, a, b, p.normal_force, contact.friction, g_mod, nu);
+        p.creep = creep_forces(
+            contact.creep_model,
+            creepages,
+            a,
+            b,
+            p.normal_force,
+            contact.friction_at(&p.geometry.params),
+            g_mod,
+            nu,
+        );
     }
 }
