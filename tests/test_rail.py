@@ -431,3 +431,29 @@ def test_a_jump_in_the_contact_force_is_an_error_not_a_wrong_load(s1002_uic60):
     # the same pose under a load above the jump is met exactly
     res = rail.contact(wheel, head, load=400e3, **kw)
     assert res["vertical_force"] == pytest.approx(400e3, rel=1e-6)
+
+
+def test_a_lubricated_gauge_face_gives_each_contact_point_its_own_friction(s1002_uic60):
+    """Issue 21: friction over the rail profile. A wheel pressed against the right rail's gauge face
+    (two points: tread and flange root) with a large lateral slip: each point saturates at the μ of its
+    own rail location, 0.1 on the lubricated gauge side and 0.4 on the top."""
+    wheel, head = s1002_uic60
+    table = rail.lubricated_gauge_face(head, mu_top=0.4, mu_gauge=0.1, depth=0.002, width=0.002)
+    assert [mu for _, mu in table] == [0.1, 0.4]
+    v_edge = table[0][0]
+    kw = dict(side="right", rail_cant=1 / 40, load=50e3, speed=20.0, lateral_velocity=1.0)
+    found = None
+    for shift in np.linspace(-0.0055, -0.0085, 31):
+        res = rail.contact(wheel, head, lateral_shift=float(shift), friction_profile=table, **kw)
+        if len(res["normal_force"]) == 2 and res["normal_force"].min() > 500.0:
+            found = res
+            break
+    assert found is not None, "a two-point contact"
+    tangential = np.hypot(found["creep_longitudinal"], found["creep_lateral"])
+    expected = np.where(found["rail_v"] < v_edge, 0.1, np.where(found["rail_v"] > v_edge + 0.002, 0.4, np.nan))
+    assert not np.isnan(expected).any(), found["rail_v"]
+    assert sorted(expected) == [0.1, 0.4]
+    np.testing.assert_allclose(found["friction"], expected, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(tangential / found["normal_force"], expected, rtol=1e-9)
+    with pytest.raises(ValueError, match=r"`friction.profile\[1\]`"):
+        rail.contact(wheel, head, lateral_shift=0.0, friction_profile=[(0.0, 0.2), (0.0, 0.3)], **kw)

@@ -263,6 +263,9 @@ class Profile:
     def eval(self, y: _F64) -> tuple[_F64, _F64, _F64]: ...
     def trim_steep_ends(self, max_slope: float) -> Profile: ...
 
+def lubricated_gauge_face(
+    rail: Profile, *, mu_top: float = 0.4, mu_gauge: float = 0.1, depth: float = 0.002, width: float = 0.002
+) -> list[tuple[float, float]]: ...
 def wheel_rail_contact(
     wheel: Profile,
     rail: Profile,
@@ -287,6 +290,7 @@ def wheel_rail_contact(
     creepages: tuple[float, float, float] | None = None,
     creep_model: str = "shen-hedrick-elkins",
     friction: float = 0.3,
+    friction_profile: list[tuple[float, float]] | None = None,
     young: float = 2.1e11,
     poisson: float = 0.3,
     scan_points: int = 400,

@@ -374,6 +374,7 @@ def contact(
     creepages: tuple[float, float, float] | None = None,
     creep_model: str = "shen-hedrick-elkins",
     friction: float = 0.3,
+    friction_profile: Sequence[tuple[float, float]] | None = None,
     young: float = 2.1e11,
     poisson: float = 0.3,
     scan_points: int = 400,
@@ -395,6 +396,10 @@ def contact(
     (rad/s, default ``speed / nominal_radius`` = pure rolling). Creepages follow from these velocities,
     or are prescribed as ``creepages = (longitudinal, lateral, spin [1/m])`` (wheel relative to rail,
     contact frame) at every point. Creep law: "shen-hedrick-elkins", "polach", "linear" or "fastsim".
+    Friction: ``friction`` everywhere, or ``friction_profile`` = ``[(v, mu), ...]``, μ over the rail
+    profile's lateral coordinate ``v`` (m, the ``y_rail`` of the result; linear between, held
+    outside), each contact point taking the μ of its own location (e.g.
+    :func:`lubricated_gauge_face`); the result's ``friction`` gives the μ of each point.
 
     The wheel is lowered onto the rail from 50 mm above its nominal height, so for a shift beyond
     flange contact (about 8 mm for S1002 on UIC 60) the flange may land on the rail head (a derailed
@@ -435,14 +440,33 @@ def contact(
     )
     kwargs: dict[str, Any] = {k: _number(v, k) for k, v in numbers.items()}
     kwargs.update({k: None if v is None else _number(v, k) for k, v in optional.items()})
+    table = None
+    if friction_profile is not None:
+        table = [(_number(v, "friction_profile"), _number(mu, "friction_profile")) for v, mu in friction_profile]
     return _core.wheel_rail_contact(
         _core_profile(wheel, "wheel"),
         _core_profile(rail, "rail"),
         side=side,
         creepages=creepages,
         creep_model=creep_model,
+        friction_profile=table,
         scan_points=int(scan_points),
         **kwargs,
+    )
+
+
+def lubricated_gauge_face(
+    rail: Profile, *, mu_top: float = 0.4, mu_gauge: float = 0.1, depth: float = 0.002, width: float = 0.002
+) -> list[tuple[float, float]]:
+    """The ``friction_profile`` of a lubricated gauge face on ``rail`` (for :func:`contact`): ``mu_gauge``
+    on the gauge side up to the point ``depth`` (m) below the rail top (2 mm: on UIC 60 about 25 mm to
+    the gauge side of the top), ``mu_top`` on the rest of the head, changing linearly over ``width`` (m)."""
+    return _core.lubricated_gauge_face(
+        _core_profile(rail, "rail"),
+        mu_top=_number(mu_top, "mu_top"),
+        mu_gauge=_number(mu_gauge, "mu_gauge"),
+        depth=_number(depth, "depth"),
+        width=_number(width, "width"),
     )
 
 
@@ -460,4 +484,5 @@ __all__ = [
     "Profile",
     "Track",
     "contact",
+    "lubricated_gauge_face",
 ]

@@ -17,7 +17,7 @@ use rail_mbs::profile::{self, Profile, ProfileError, ProfileKind};
 use rail_mbs::track::{INCH, Side, Track, TrackError, TrackPoint};
 use rail_mbs::wheel_rail::validate::ValidationError;
 use rail_mbs::wheel_rail::{
-    ContactError, CreepModel, Creepages, Material, RailGeometry, RailPath, VerticalTarget, WheelGeometry,
+    ContactError, CreepModel, Creepages, FrictionMap, Material, RailGeometry, RailPath, VerticalTarget, WheelGeometry,
     WheelRailContact, WheelState, solve_vertical,
 };
 
@@ -635,7 +635,7 @@ fn creep_model_of(name: &str) -> PyResult<CreepModel> {
                     gauge=1.435, gauge_depth=0.014, rail_cant=0.0, trim_slope=None, lateral_shift=0.0, yaw=0.0,
                     roll=0.0, load=None, penetration=None, speed=0.0, lateral_velocity=0.0, yaw_rate=0.0,
                     axle_rate=None, creepages=None, creep_model="shen-hedrick-elkins", friction=0.3,
-                    young=2.1e11, poisson=0.3, scan_points=400))]
+                    friction_profile=None, young=2.1e11, poisson=0.3, scan_points=400))]
 #[allow(clippy::too_many_arguments)]
 pub fn wheel_rail_contact<'py>(
     py: Python<'py>,
@@ -661,11 +661,20 @@ pub fn wheel_rail_contact<'py>(
     creepages: Option<[f64; 3]>,
     creep_model: &str,
     friction: f64,
+    friction_profile: Option<Vec<(f64, f64)>>,
     young: f64,
     poisson: f64,
     scan_points: i64,
 ) -> PyResult<Bound<'py, PyDict>> {
     let side = side_of(side)?;
+    let friction_map = match friction_profile {
+        Some(profile) => {
+            let m = FrictionMap { profile, along_track: Vec::new() };
+            m.validate().map_err(|e| PyValueError::new_err(e.to_string()))?;
+            Some(Arc::new(m))
+        }
+        None => None,
+    };
     in_range("nominal_radius", nominal_radius, 0.1, 1.5, "m")?;
     in_range("wheel_offset", wheel_offset, 0.3, 1.2, "m")?;
     in_range("gauge", gauge, 0.6, 2.0, "m")?;
@@ -741,6 +750,7 @@ pub fn wheel_rail_contact<'py>(
     contact.wheel_material = mat;
     contact.rail_material = mat;
     contact.friction = friction;
+    contact.friction_map = friction_map;
     contact.creep_model = model;
     contact.settings.scan_points = scan_points;
     let state = WheelState { lateral_shift, yaw, roll, speed, lateral_velocity, yaw_rate, axle_rate, creepages };
@@ -758,6 +768,8 @@ pub fn wheel_rail_contact<'py>(
     let col = |f: &dyn Fn(&rail_mbs::wheel_rail::ContactPoint) -> f64| pts.iter().map(f).collect::<Vec<f64>>();
     let vec3 = |f: &dyn Fn(&rail_mbs::wheel_rail::ContactPoint) -> [f64; 3]| pts.iter().map(f).collect::<Vec<_>>();
     d.set_item("y_track", arr(py, col(&|p| p.point().y)))?;
+    d.set_item("friction", arr(py, col(&|p| contact.friction_at(&p.geometry.params))))?;
+    d.set_item("rail_v", arr(py, col(&|p| p.geometry.params[1])))?;
     d.set_item("y_rail", arr(py, col(&|p| p.geometry.params[1])))?;
     d.set_item("y_wheel", arr(py, col(&|p| p.geometry.params[2])))?;
     d.set_item("rolling_radius", arr(py, col(&|p| nominal_radius - contact.wheel.profile.z(p.geometry.params[2]))))?;
@@ -784,10 +796,28 @@ pub fn wheel_rail_contact<'py>(
 }
 
 /// Registers the classes and functions of this file in `railslosh._core`.
+/// The `(v, μ)` table of a lubricated gauge face on `rail` (`rail_mbs::wheel_rail::FrictionMap::
+/// lubricated_gauge_face`): `mu_gauge` on the gauge side up to the point `depth` (m) below the
+/// rail top, `mu_top` on the rest of the head, linear over `width` (m).
+#[pyfunction]
+#[pyo3(signature = (rail, *, mu_top=0.4, mu_gauge=0.1, depth=0.002, width=0.002))]
+pub fn lubricated_gauge_face(
+    rail: &PyProfile,
+    mu_top: f64,
+    mu_gauge: f64,
+    depth: f64,
+    width: f64,
+) -> PyResult<Vec<(f64, f64)>> {
+    FrictionMap::lubricated_gauge_face(&rail.inner, mu_top, mu_gauge, depth, width)
+        .map(|m| m.profile)
+        .map_err(|e| PyValueError::new_err(e.to_string()))
+}
+
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("DataNotFoundError", m.py().get_type::<DataNotFoundError>())?;
     m.add_class::<PyTrack>()?;
     m.add_class::<PyProfile>()?;
     m.add_function(wrap_pyfunction!(wheel_rail_contact, m)?)?;
+    m.add_function(wrap_pyfunction!(lubricated_gauge_face, m)?)?;
     Ok(())
 }

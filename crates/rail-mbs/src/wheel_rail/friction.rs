@@ -45,8 +45,9 @@ impl FrictionMap {
     }
 
     /// A lubricated gauge face: `mu_gauge` on the gauge side of the rail up to the point
-    /// `depth` below the rail's highest point (the edge of the running band; 3 mm is usual),
-    /// `mu_top` on the rest of the head, changing linearly over `width` (m) towards the top.
+    /// `depth` below the rail's highest point (2 mm: on UIC 60 about 25 mm to the gauge side
+    /// of the top), `mu_top` on the rest of the head, changing linearly over `width` (m)
+    /// towards the top.
     pub fn lubricated_gauge_face(
         rail: &Profile,
         mu_top: f64,
