@@ -457,3 +457,50 @@ def test_a_lubricated_gauge_face_gives_each_contact_point_its_own_friction(s1002
     np.testing.assert_allclose(tangential / found["normal_force"], expected, rtol=1e-9)
     with pytest.raises(ValueError, match=r"`friction.profile\[1\]`"):
         rail.contact(wheel, head, lateral_shift=0.0, friction_profile=[(0.0, 0.2), (0.0, 0.3)], **kw)
+
+
+@pytest.mark.parametrize("mu", [0.3, 0.5])
+def test_a_wheel_pushed_into_flange_contact_climbs_at_the_nadal_limit(s1002_uic60, mu):
+    """Issue 21 (derailment use), quasi-static: the left S1002 wheel carries 50 kN and slides on the
+    rail with a saturated lateral creepage (η = -0.05, the climbing direction, no longitudinal creep).
+    Shifted into flange contact, the L/V it holds is Nadal's (tan δ − μ)/(1 + μ tan δ) at each point's
+    own contact angle δ; the largest L/V over the shifts, where the wheel starts to climb (beyond it
+    the contact angle falls as the flange rides up), is Nadal's limit at the profile's flange angle."""
+    from railslosh import indicators
+
+    wheel, head = s1002_uic60
+    lv = []
+    jumps = 0
+    for shift in np.linspace(0.0070, 0.0110, 41):
+        try:
+            res = rail.contact(
+                wheel,
+                head,
+                side="left",
+                rail_cant=1 / 40,
+                lateral_shift=float(shift),
+                load=50e3,
+                speed=5.0,
+                creepages=(0.0, -0.05, 0.0),
+                friction=mu,
+            )
+        except rs.RailsloshError as exc:  # the jump from the flange root onto the flange: no height carries 50 kN
+            assert "discontinuous" in str(exc)
+            jumps += 1
+            continue
+        if len(res["normal_force"]) != 1:
+            continue
+        delta = float(res["contact_angle"][0])
+        ratio = -res["lateral_force"] / res["vertical_force"]
+        # the flange's angles: Nadal at each point (nadal_limit takes degrees)
+        if delta > math.radians(45.0):
+            assert ratio == pytest.approx(indicators.nadal_limit(math.degrees(delta), mu), rel=1e-9)
+        lv.append((ratio, math.degrees(delta)))
+    assert len(lv) >= 30 and jumps <= 6, (len(lv), jumps)
+    peak, steepest = max(lv)
+    # the steepest point is the S1002 flange angle (70°; measured 70.03-70.04° on the spline of the
+    # tabulated profile), and the wheel climbs at Nadal's limit there: 0.1-0.2 % above the 70° value
+    print(f"mu = {mu}: steepest contact angle {steepest:.4f} deg, L/V {peak:.6f}")
+    assert steepest == pytest.approx(indicators.FLANGE_ANGLE["s1002"], abs=0.15), steepest
+    assert peak == pytest.approx(indicators.nadal_limit(steepest, mu), rel=1e-9)
+    assert peak == pytest.approx(indicators.nadal_limit(indicators.FLANGE_ANGLE["s1002"], mu), rel=2e-3)
