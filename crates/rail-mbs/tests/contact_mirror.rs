@@ -157,3 +157,55 @@ fn the_contact_of_a_pose_does_not_depend_on_the_search_history() {
     println!("history against fresh search: worst relative difference {worst:.2e}, {fallbacks} scan fall-backs");
     assert!(worst < 1e-9, "{worst}");
 }
+
+#[test]
+fn the_contact_does_not_depend_on_where_the_track_lies() {
+    // The same wheel on the same straight track, once from the global origin and once moved
+    // 3.7 m to the left and 0.4 m up (and started 250 m further along X): the contact forces
+    // are equal up to the round-off of the larger coordinates.
+    use rail_mbs::track::{Track, TrackPoint};
+    use std::sync::Arc;
+    let pts = || {
+        vec![TrackPoint::new(0.0, 0.0, 0.0, 0.0, 0.025, -0.025), TrackPoint::new(500.0, 0.0, 0.0, 0.0, 0.025, -0.025)]
+    };
+    let shift = Vector3::new(250.0, 3.7, 0.4);
+    let make = |origin: Vector3<f64>| {
+        let track = Arc::new(Track::with_origin(pts(), origin, 0.0).unwrap());
+        let rail = uic60_rail(2e-4).unwrap();
+        let offset = RailGeometry::offset_for_gauge(&rail, 1.435, 0.014).unwrap();
+        WheelRailContact::new(
+            WheelGeometry {
+                profile: s1002_wheel(2e-4).unwrap(),
+                nominal_radius: 0.46,
+                profile_offset: 0.75,
+                side: Side::Left,
+            },
+            RailGeometry {
+                profile: rail,
+                side: Side::Left,
+                profile_offset: offset,
+                vertical_offset: 0.0,
+                path: RailPath::Track(track),
+            },
+        )
+    };
+    let (mut here, mut there) = (make(Vector3::zeros()), make(shift));
+    let mut worst: f64 = 0.0;
+    for k in 0..=40 {
+        let y = -0.004 + 3e-4 * k as f64;
+        let mut pose = WheelPose {
+            position: Vector3::new(100.0, y, 0.46),
+            rotation: rot(0.002, 0.0),
+            velocity: Vector3::new(20.0, 0.05, 0.0),
+            angular_velocity: Vector3::new(0.0, 20.0 / 0.46 * 1.001, 0.0),
+        };
+        pose.position.z = height_for_load(&mut here, &pose, 6e4);
+        let moved = WheelPose { position: pose.position + shift, ..pose };
+        let (fa, _, na) = resultant(&mut here, &pose);
+        let (fb, _, nb) = resultant(&mut there, &moved);
+        assert_eq!(na.len(), nb.len(), "y = {y}");
+        worst = worst.max((fa - fb).norm() / fa.norm());
+    }
+    println!("track moved by {shift:?}: worst relative force difference {worst:.2e}");
+    assert!(worst < 1e-9, "{worst}");
+}
