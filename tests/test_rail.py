@@ -504,3 +504,27 @@ def test_a_wheel_pushed_into_flange_contact_climbs_at_the_nadal_limit(s1002_uic6
     assert steepest == pytest.approx(indicators.FLANGE_ANGLE["s1002"], abs=0.15), steepest
     assert peak == pytest.approx(indicators.nadal_limit(steepest, mu), rel=1e-9)
     assert peak == pytest.approx(indicators.nadal_limit(indicators.FLANGE_ANGLE["s1002"], mu), rel=2e-3)
+
+
+def test_the_tangential_laws_take_their_parameters(s1002_uic60):
+    """Issue 21: Polach's k_A/k_S and FASTSIM's grid are parameters, not fixed. Polach with
+    k_A = k_S = 1 is the default; smaller reduction factors lower the creep force; FASTSIM converges
+    with its grid; unknown or out-of-range parameters name the field."""
+    wheel, head = s1002_uic60
+    kw = dict(rail_cant=1 / 40, lateral_shift=0.002, load=50e3, speed=20.0, creepages=(1e-3, 0.0, 0.0))
+
+    def fx(model, params=None):
+        return rail.contact(wheel, head, creep_model=model, creep_parameters=params, **kw)["creep_longitudinal"].sum()
+
+    assert fx("polach", {"k_a": 1.0, "k_s": 1.0}) == fx("polach")
+    assert abs(fx("polach", {"k_a": 0.3, "k_s": 0.3})) < abs(fx("polach"))
+    coarse, fine, finest = (fx("fastsim", {"nx": n, "ny": n}) for n in (10, 40, 160))
+    assert abs(fine - finest) < abs(coarse - finest), (coarse, fine, finest)
+    assert fine == pytest.approx(finest, rel=0.02)
+    assert fx("fastsim", {"nx": 40, "ny": 40}) == fx("fastsim")
+    with pytest.raises(ValueError, match=r"`creep_parameters`"):
+        fx("polach", {"nx": 10})
+    with pytest.raises(ValueError, match=r"`creep_parameters.k_a` = 1.5"):
+        fx("polach", {"k_a": 1.5})
+    with pytest.raises(ValueError, match=r"`creep_parameters.nx` = 1"):
+        fx("fastsim", {"nx": 1})

@@ -289,6 +289,7 @@ def wheel_rail_contact(
     axle_rate: float | None = None,
     creepages: tuple[float, float, float] | None = None,
     creep_model: str = "shen-hedrick-elkins",
+    creep_parameters: dict[str, float] | None = None,
     friction: float = 0.3,
     friction_profile: list[tuple[float, float]] | None = None,
     young: float = 2.1e11,

@@ -373,6 +373,7 @@ def contact(
     axle_rate: float | None = None,
     creepages: tuple[float, float, float] | None = None,
     creep_model: str = "shen-hedrick-elkins",
+    creep_parameters: dict[str, float] | None = None,
     friction: float = 0.3,
     friction_profile: Sequence[tuple[float, float]] | None = None,
     young: float = 2.1e11,
@@ -395,7 +396,9 @@ def contact(
     ``roll`` (rad), moving forward at ``speed`` (m/s) and spinning about the axle at ``axle_rate``
     (rad/s, default ``speed / nominal_radius`` = pure rolling). Creepages follow from these velocities,
     or are prescribed as ``creepages = (longitudinal, lateral, spin [1/m])`` (wheel relative to rail,
-    contact frame) at every point. Creep law: "shen-hedrick-elkins", "polach", "linear" or "fastsim".
+    contact frame) at every point. Creep law: "shen-hedrick-elkins", "polach", "linear" or "fastsim";
+    ``creep_parameters``: Polach's reduction factors ``{"k_a": ..., "k_s": ...}`` (each in (0, 1],
+    default 1) or FASTSIM's grid ``{"nx": ..., "ny": ...}`` (2–400 cells, default 40 × 40).
     Friction: ``friction`` everywhere, or ``friction_profile`` = ``[(v, mu), ...]``, μ over the rail
     profile's lateral coordinate ``v`` (m, the ``y_rail`` of the result; linear between, held
     outside), each contact point taking the μ of its own location (e.g.
@@ -449,6 +452,7 @@ def contact(
         side=side,
         creepages=creepages,
         creep_model=creep_model,
+        creep_parameters=None if creep_parameters is None else dict(creep_parameters),
         friction_profile=table,
         scan_points=int(scan_points),
         **kwargs,

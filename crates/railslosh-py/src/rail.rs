@@ -614,12 +614,55 @@ impl PyProfile {
 // Contact
 // ---------------------------------------------------------------------------------------
 
-fn creep_model_of(name: &str) -> PyResult<CreepModel> {
+/// The creep law `name` with its parameters: Polach's reduction factors `k_a`, `k_s` (default
+/// 1, 1; each in (0, 1]) and FASTSIM's grid `nx`, `ny` (default 40 × 40; each 2 to 400).
+fn creep_model_of(name: &str, params: Option<&Bound<'_, PyDict>>) -> PyResult<CreepModel> {
+    let get = |key: &str, default: f64| -> PyResult<f64> {
+        match params.map(|d| d.get_item(key)).transpose()?.flatten() {
+            Some(v) => v.extract::<f64>().map_err(|_| invalid(&format!("creep_parameters.{key}"), v, "a number")),
+            None => Ok(default),
+        }
+    };
+    let allowed: &[&str] = match name {
+        "polach" => &["k_a", "k_s"],
+        "fastsim" => &["nx", "ny"],
+        _ => &[],
+    };
+    if let Some(d) = params {
+        for k in d.keys() {
+            let k: String = k.extract()?;
+            if !allowed.contains(&k.as_str()) {
+                return Err(invalid(
+                    "creep_parameters",
+                    format!("{k:?}"),
+                    &format!("one of {allowed:?} with creep_model {name:?}"),
+                ));
+            }
+        }
+    }
     match name {
         "shen-hedrick-elkins" => Ok(CreepModel::ShenHedrickElkins),
-        "polach" => Ok(CreepModel::Polach { k_a: 1.0, k_s: 1.0 }),
+        "polach" => {
+            let k_a = get("k_a", 1.0)?;
+            let k_s = get("k_s", 1.0)?;
+            for (k, v) in [("creep_parameters.k_a", k_a), ("creep_parameters.k_s", k_s)] {
+                if !(v > 0.0 && v <= 1.0) {
+                    return Err(invalid(k, v, "a reduction factor in (0, 1]"));
+                }
+            }
+            Ok(CreepModel::Polach { k_a, k_s })
+        }
         "linear" => Ok(CreepModel::Linear),
-        "fastsim" => Ok(CreepModel::Fastsim { nx: 40, ny: 40 }),
+        "fastsim" => {
+            let nx = get("nx", 40.0)?;
+            let ny = get("ny", 40.0)?;
+            for (k, v) in [("creep_parameters.nx", nx), ("creep_parameters.ny", ny)] {
+                if !(v.fract() == 0.0 && (2.0..=400.0).contains(&v)) {
+                    return Err(invalid(k, v, "a whole number of cells from 2 to 400"));
+                }
+            }
+            Ok(CreepModel::Fastsim { nx: nx as usize, ny: ny as usize })
+        }
         other => Err(invalid(
             "creep_model",
             format!("{other:?}"),
@@ -634,8 +677,8 @@ fn creep_model_of(name: &str) -> PyResult<CreepModel> {
 #[pyo3(signature = (wheel, rail, *, side="left", nominal_radius=0.46, wheel_offset=0.75, rail_offset=None,
                     gauge=1.435, gauge_depth=0.014, rail_cant=0.0, trim_slope=None, lateral_shift=0.0, yaw=0.0,
                     roll=0.0, load=None, penetration=None, speed=0.0, lateral_velocity=0.0, yaw_rate=0.0,
-                    axle_rate=None, creepages=None, creep_model="shen-hedrick-elkins", friction=0.3,
-                    friction_profile=None, young=2.1e11, poisson=0.3, scan_points=400))]
+                    axle_rate=None, creepages=None, creep_model="shen-hedrick-elkins", creep_parameters=None,
+                    friction=0.3, friction_profile=None, young=2.1e11, poisson=0.3, scan_points=400))]
 #[allow(clippy::too_many_arguments)]
 pub fn wheel_rail_contact<'py>(
     py: Python<'py>,
@@ -660,6 +703,7 @@ pub fn wheel_rail_contact<'py>(
     axle_rate: Option<f64>,
     creepages: Option<[f64; 3]>,
     creep_model: &str,
+    creep_parameters: Option<&Bound<'py, PyDict>>,
     friction: f64,
     friction_profile: Option<Vec<(f64, f64)>>,
     young: f64,
@@ -714,7 +758,7 @@ pub fn wheel_rail_contact<'py>(
             Some(Creepages { longitudinal: c[0], lateral: c[1], spin: c[2] })
         }
     };
-    let model = creep_model_of(creep_model)?;
+    let model = creep_model_of(creep_model, creep_parameters)?;
     if let Some(o) = rail_offset {
         in_range("rail_offset", o, 0.3, 1.2, "m")?;
     }
