@@ -292,6 +292,7 @@ def test_add_indicators_on_a_vehicle_run_stores_variables_with_units(braking, tm
         "wheel_vertical_del",
         "wheel_vertical_crossings",
         "iso2631_weighted_rms",
+        "sperling_wz",
     }
     assert set(new) == expected
     for n in new:
@@ -311,9 +312,14 @@ def test_add_indicators_on_a_vehicle_run_stores_variables_with_units(braking, tm
         indicators.damage_equivalent_load(braking["coupler_force"].sel(coupler=1).values, 5.0, 0.4)
     )
     assert float(ds["coupler_force_del"].sel(coupler=1)) > 0
-    # the ride value is derived from the speed, and says so
-    assert "tank_speed" in ds["iso2631_weighted_rms"].attrs["derived"]
-    assert "Sperling" in ds.attrs["indicators_skipped"]
+    # the ride values come from the recorded car-body acceleration (every vehicle run records it)
+    assert ds["iso2631_weighted_rms"].attrs["source"] == "car_acceleration"
+    assert ds.sizes["iso_axis"] == 3 and ds["sperling_wz"].sizes["direction"] == 2
+    assert "Sperling" not in ds.attrs.get("indicators_skipped", "")
+    # without it, the longitudinal ride value is derived from the speed, and says so
+    old = indicators.add_indicators(braking.drop_vars("car_acceleration"), wohler_exponent=5.0)
+    assert "tank_speed" in old["iso2631_weighted_rms"].attrs["derived"]
+    assert "Sperling" in old.attrs["indicators_skipped"]
     # a results file keeps them
     back = results.load(results.save(ds, tmp_path / "results.nc"))
     assert back["weinstock_max"].attrs["standard"] == ds["weinstock_max"].attrs["standard"]

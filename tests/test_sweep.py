@@ -38,6 +38,10 @@ def test_grid_names_set_the_documented_scene_fields():
         sweep.grid_overrides(base, {"braking": "hard"})
     with pytest.raises(ValueError, match="invalid `bulkheads`"):
         sweep.grid_overrides(base, {"bulkheads": 1.5})
+    # issue 20: the track class of the irregularity and the liquid model are grid axes too
+    track = sweep.grid_overrides(base, {"track_class": 3, "model": "pendulum"})
+    assert track["track"] == {"irregularities": {"class": 3}}
+    assert track["fluid"] == {"slosh_model": "pendulum"}
 
 
 def test_a_bad_point_is_reported_before_anything_runs():

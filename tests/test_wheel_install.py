@@ -111,7 +111,8 @@ def test_every_example_runs_from_the_installed_tool(fresh_venv):
         assert summary["t_reached"] == pytest.approx(QUICK_T_END) and summary["error"] is None, p.stem
         assert (out / "results.nc").is_file(), p.stem
         assert any((out / "plots").glob("*.png")) == (p == first), p.stem
-        if summary["kind"] == "fluid_vehicle":
+        if summary["kind"] == "fluid_vehicle" and summary.get("fluid_model") == "ancf":
+            # the ANCF liquid's snapshots (a liquid run as rigid lading or pendulum has no mesh)
             assert (out / "fluid.pvd").is_file() and any((out / "fluid").glob("*.vtu")), p.stem
 
 

@@ -5,7 +5,7 @@ analysis and the ``railslosh`` command-line tool. Units are SI throughout; frame
 conventions are defined in ``docs/frames.md``.
 """
 
-from railslosh import constants, fluids, mesh, rail, scene, slosh, vehicle
+from railslosh import constants, fluids, irregularity, mesh, rail, scene, slosh, vehicle
 from railslosh._core import (
     Fluid,
     FluidBody,
@@ -23,6 +23,7 @@ __all__ = [
     "__version__",
     "constants",
     "fluids",
+    "irregularity",
     "mass_matrix",
     "mesh",
     "rail",

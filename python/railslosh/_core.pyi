@@ -307,7 +307,7 @@ def track_irregularity(
     track_class: int | None = None,
     start: float = 0.0,
     step: float = 0.25,
-    wavelengths: tuple[float, float] = (1.0, 70.0),
+    wavelengths: tuple[float, float] = ...,
     seed: int = 1,
     taper: float = 20.0,
     channels: list[str] | None = None,

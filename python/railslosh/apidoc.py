@@ -14,6 +14,7 @@ MODULES = (
     "railslosh.body",
     "railslosh.slosh",
     "railslosh.rail",
+    "railslosh.irregularity",
     "railslosh.vehicle",
     "railslosh.scene",
     "railslosh.limits",

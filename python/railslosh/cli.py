@@ -218,6 +218,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
     }
     # the model the run used (run_scene records it, also on a failed run)
     summary |= {k: res[k] for k in ("fluid_model", "fluid_model_reason", "stepper", "stepper_reason") if k in res}
+    if res.get("irregularity") is not None:  # the track irregularity: where it came from, its RMS per channel
+        summary["irregularity"] = res["irregularity"].summary()
     (out / "run.json").write_text(json.dumps(summary, indent=1, default=str), encoding="utf-8")
     print(
         f"  {st.get('steps', 0)} steps, {st.get('newton_iterations', 0)} Newton iterations, "

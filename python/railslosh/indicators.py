@@ -462,7 +462,8 @@ def level_crossings(x: Any, levels: Any, reference: float | None = None) -> np.n
 
 ACCELERATION_VARIABLE = "car_acceleration"
 """Name of a car-body acceleration variable ``(time, car, component)`` in m/s² (tank/car frame:
-x forward, y left, z up) that :func:`add_indicators` rates for ride; the runs record none yet."""
+x forward, y left, z up) that :func:`add_indicators` rates for ride; every vehicle run records it
+(``rail_mbs::vehicle::TrainRecord::car_acceleration``, filtered like the loads)."""
 
 _SPECTRA = ("coupler_force", "wheel_vertical", "fluid_force_tank", "force_tank")
 

@@ -82,6 +82,10 @@ LABELS: dict[str, tuple[str, str, str]] = {
     "energy_error": ("Energy growth ε (≤ 0 physical)", "ε", "ratio"),
     "min_volume_ratio": ("Smallest volume ratio J", "J", "ratio"),
     "containment_gap": ("Largest gap beyond a wall", "Gap", "length"),
+    "irregularity_vertical": ("Vertical profile (mean rail height, up +)", "Vertical profile", "length"),
+    "irregularity_alignment": ("Alignment (mean rail position, left +)", "Alignment", "length"),
+    "irregularity_cross_level": ("Cross-level (right minus left rail)", "Cross-level", "length"),
+    "irregularity_gauge": ("Gauge widening", "Gauge widening", "length"),
 }
 
 # quantity -> ((unit, factor from SI, used from this |SI value| up), ...), smallest first
@@ -168,7 +172,10 @@ def limits(ds: Any, name: str) -> list[tuple[float, str, str]]:
     return []
 
 
+_IRREGULARITY = tuple(f"irregularity_{c}" for c in ("vertical", "alignment", "cross_level", "gauge"))
+
 # (file stem, title, variables, panels): "one" panel, one per "component", per "car" or per "variable"
+# against time; the track irregularity's channels against "distance", and their "psd" (log-log)
 PLOTS: tuple[tuple[str, str, tuple[str, ...], str], ...] = (
     ("coupler_force", "Coupler forces (tension positive)", ("coupler_force",), "one"),
     ("fluid_force", "Force of the liquid on each tank (tank frame)", ("fluid_force_tank",), "component"),
@@ -182,6 +189,8 @@ PLOTS: tuple[tuple[str, str, tuple[str, ...], str], ...] = (
     ("slosh_moment", "Moment of the liquid on the tank about its centre (tank frame)", ("moment_tank",), "component"),
     ("slosh_com", "Liquid centre of mass (tank frame)", ("com_tank",), "component"),
     ("energy", "Energies of the liquid", ("kinetic_energy", "potential_energy"), "variable"),
+    ("irregularity", "Track irregularity along the track", _IRREGULARITY, "distance"),
+    ("irregularity_psd", "Track irregularity spectra (one-sided PSD) against the target", _IRREGULARITY, "psd"),
 )
 
 
@@ -338,6 +347,120 @@ def _draw(fig: Any, ds: Any, spec: tuple[str, str, tuple[str, ...], str]) -> Non
         fig.text(0.995, 0.005, f"frame: {frame} (docs/frames.md)", ha="right", va="bottom", fontsize=7, color="0.4")
 
 
+def _irregularity(ds: Any) -> tuple[Any, dict[str, Any]] | None:
+    """The run's track irregularity (:class:`railslosh.irregularity.Irregularity`) and its spec,
+    rebuilt from the Dataset, or None."""
+    from railslosh import results
+    from railslosh.irregularity import CHANNELS, Irregularity
+
+    spec = results.irregularity_spec(ds)
+    if spec is None or "distance" not in ds.coords or not all(n in ds.data_vars for n in _IRREGULARITY):
+        return None
+    d = np.asarray(ds["distance"].values, dtype=float)
+    arrays = [np.asarray(ds[f"irregularity_{c}"].values, dtype=float) for c in CHANNELS]
+    if d.size < 2 or not all(np.isfinite(a).all() for a in arrays):
+        return None
+    step = float(spec.get("step", (d[-1] - d[0]) / (d.size - 1)))
+    return Irregularity(float(d[0]), step, *arrays), spec
+
+
+def _wavelength(x: Any) -> Any:
+    """λ = 2π/Ω and back (the top axis of the spectra)."""
+    with np.errstate(divide="ignore"):
+        return 2 * np.pi / np.asarray(x, dtype=float)
+
+
+def _irregularity_title(spec: dict[str, Any], *, seed: bool = True) -> str:
+    kind = spec.get("kind", "")
+    what = {
+        "fra": f"FRA class {spec.get('class', '?')}",
+        "erri_low": "ERRI B176 low level",
+        "erri_high": "ERRI B176 high level",
+        "file": f"file {Path(str(spec.get('file', ''))).name}",
+        "perfect": "perfect track",
+        "samples": "samples",
+    }.get(kind, kind)
+    if seed and "seed" in spec:
+        what += f", seed {spec['seed']}"
+    if seed and spec.get("defects"):
+        what += f", {len(spec['defects'])} defect(s)"
+    return what
+
+
+def _irregularity_channels(irr: Any) -> list[str]:
+    """The channels of an irregularity that are not zero throughout."""
+    from railslosh.irregularity import CHANNELS
+
+    return [c for c in CHANNELS if np.any(irr.channel(c) != 0.0)]
+
+
+def _draw_irregularity(fig: Any, irr: Any, spec: dict[str, Any], ds: Any, plot: tuple[str, str, Any, str]) -> None:
+    """The channels of the run's track irregularity ``irr`` against distance (panels
+    ``"distance"``), or their Welch PSD with the target spectrum as a black line (``"psd"``)."""
+    from railslosh import irregularity
+
+    _, title, _, kind = plot
+    channels = _irregularity_channels(irr)
+    axes = fig.subplots(len(channels), 1, sharex=True, squeeze=False)[:, 0]
+    if kind == "psd":
+        # the samples past the taper (the ramp from zero is not part of the spectrum)
+        start = irr.start + float(spec.get("taper", 0.0) or 0.0)
+        n = int(np.count_nonzero(irr.distance >= start - 1e-9 * irr.step))
+        nperseg = min(irregularity.WELCH_NPERSEG, n // 2)
+        wl = spec.get("wavelengths")
+        for ax, c in zip(axes, channels, strict=True):
+            w, p = irregularity.welch_psd(irr, c, nperseg, start=start)
+            lo, hi = (2 * np.pi / wl[1], 2 * np.pi / wl[0]) if wl else (float(w[0]), float(w[-1]))
+            # the requested band and a little beyond (Hann leakage fills the rest with orders of
+            # magnitude of nothing)
+            shown = (w >= lo / 1.5) & (w <= hi * 1.5) & (p > 0)
+            ax.loglog(w[shown], p[shown], label=f"Welch estimate ({nperseg} samples a segment, after the taper)")
+            ys = [p[shown & (w >= lo) & (w <= hi)]]
+            if spec.get("kind") in irregularity.SPECTRA:
+                band = np.geomspace(lo, hi, 200)
+                target = irregularity.psd(spec["kind"], c, band, spec.get("class"))
+                ax.loglog(band, target, color="k", lw=1.0, label=f"target: {_irregularity_title(spec, seed=False)}")
+                ys.append(target[target > 0])
+            for x, text in ((lo, "wavelength range of the track" if wl else None), (hi, None)):
+                ax.axvline(x, color="0.5", ls=":", lw=0.8, label=text)
+            y = np.concatenate(ys)
+            if y.size:
+                ax.set_ylim(float(y.min()) / 10, float(y.max()) * 10)
+            ax.set_xlim(lo / 1.5, hi * 1.5)
+            ax.set_ylabel(f"{LABELS[f'irregularity_{c}'][1]}\n(m²/(rad/m))")
+            if len(ax.get_lines()) > 1:
+                ax.legend(loc="lower left", fontsize=7)
+        axes[-1].set_xlabel("Spatial angular frequency Ω = 2π/λ (rad/m)")
+        top = axes[0].secondary_xaxis("top", functions=(_wavelength, _wavelength))
+        top.set_xlabel("Wavelength λ (m)")
+    else:
+        unit, f = display_unit(_IRREGULARITY[0], np.concatenate([irr.channel(c) for c in channels]))
+        d = irr.distance
+        span = None
+        if "tank_station" in ds.data_vars and ds["tank_station"].size:
+            st = np.asarray(ds["tank_station"].values, dtype=float)
+            if np.isfinite(st).any():
+                span = (float(np.nanmin(st)), float(np.nanmax(st)))
+        for k, (ax, c) in enumerate(zip(axes, channels, strict=True)):
+            ax.plot(d, irr.channel(c) * f)
+            if span is not None:
+                ax.axvspan(*span, color="0.88", zorder=0, lw=0, label="tank centres during the run" if k == 0 else None)
+            ax.set_ylabel(_with_unit(LABELS[f"irregularity_{c}"][1], unit))
+            _min_span(ax, _RESOLUTION["length"] * f)
+        xlabel = "Distance along the track s (m)"
+        if span is not None:
+            axes[0].legend(loc="upper left", bbox_to_anchor=(1.01, 1.0))
+            # the part the train ran over (its front wheelset is ahead of the front tank centre)
+            right = span[1] + 30.0
+            if right < irr.end:
+                axes[-1].set_xlim(min(irr.start, span[0]) - 5.0, right)
+                xlabel += f"; the part run over (the irregularity goes on to {irr.end:.6g} m)"
+        axes[-1].set_xlabel(xlabel)
+    run = ds.attrs.get("title", "")
+    fig.suptitle(f"{title}\n{_irregularity_title(spec)}{f' — {run}' if run else ''}")
+    fig.text(0.995, 0.005, "frame: track (docs/frames.md)", ha="right", va="bottom", fontsize=7, color="0.4")
+
+
 def figure(ds: Any, stem: str) -> Any:
     """The :class:`matplotlib.figure.Figure` of plot ``stem`` (:data:`PLOTS`), drawn in
     :data:`STYLE`, or ``None`` when the Dataset lacks its variables or has fewer than 2 samples."""
@@ -347,6 +470,17 @@ def figure(ds: Any, stem: str) -> Any:
     spec = next((p for p in PLOTS if p[0] == stem), None)
     if spec is None:
         raise ValueError(f"invalid `stem` = {stem!r}: expected one of {', '.join(p[0] for p in PLOTS)}")
+    if spec[3] in ("distance", "psd"):
+        got = _irregularity(ds)
+        if got is None or not _irregularity_channels(got[0]):
+            return None
+        if spec[3] == "psd" and np.count_nonzero(got[0].distance >= got[0].start + got[1].get("taper", 0.0)) < 16:
+            return None  # too short a track past the taper for a spectrum
+        with matplotlib.style.context(STYLE):
+            n = len(_irregularity_channels(got[0]))
+            fig = Figure(figsize=(9.0, 1.2 + 1.9 * n if n > 1 else 4.2))
+            _draw_irregularity(fig, got[0], got[1], ds, spec)
+        return fig
     if not any(n in ds.data_vars and ds[n].size for n in spec[2]) or ds.sizes.get("time", 0) < 2:
         return None
     with matplotlib.style.context(STYLE):

@@ -334,13 +334,56 @@ def _track(rows: list[list[float]]) -> dict[str, Any]:
     return {"header": header, "rows": out}
 
 
+def _irregularity(ds: Any) -> list[tuple[str, str]]:
+    """The run's track irregularity in words (:func:`railslosh.results.irregularity_spec`): where it
+    came from, its grid and its RMS per channel in mm."""
+    from railslosh import results
+
+    spec = results.irregularity_spec(ds)
+    if spec is None:
+        return []
+    kinds = {
+        "fra": "US FRA track spectrum",
+        "erri_low": "ERRI B176 low-level spectrum",
+        "erri_high": "ERRI B176 high-level spectrum",
+        "file": "measured file",
+        "perfect": "perfect track with defects",
+        "samples": "samples",
+    }
+    rows = [("kind", kinds.get(str(spec.get("kind")), str(spec.get("kind"))))]
+    for key, text in (("class", "FRA class"), ("seed", "seed"), ("file", "file"), ("units", "file units")):
+        if key in spec:
+            rows.append((text, str(spec[key])))
+    if "sha256" in spec:
+        rows.append(("file SHA-256", str(spec["sha256"])[:16] + "…"))
+    if "wavelengths" in spec:
+        lo, hi = spec["wavelengths"]
+        rows.append(("wavelengths", f"{num(lo, strip=True)}–{num(hi, strip=True)} m"))
+    if "taper" in spec:
+        rows.append(("taper", f"{num(spec['taper'], strip=True)} m"))
+    if "first" in spec and "last" in spec:
+        rows.append(("from s", f"{num(spec['first'], 6, strip=True)} to {num(spec['last'], 6, strip=True)} m"))
+    if "step" in spec:
+        rows.append(("sample spacing", f"{num(spec['step'], strip=True)} m"))
+    if spec.get("channels"):
+        rows.append(("channels", ", ".join(spec["channels"])))
+    for d in spec.get("defects") or []:
+        text = ", ".join(f"{k.replace('_', ' ')} {num(v, strip=True)} m" for k, v in d.items() if k != "type")
+        rows.append((f"defect: {str(d.get('type', '')).replace('_', ' ')}", text))
+    for c, v in (spec.get("rms") or {}).items():
+        if float(v) > 0:  # channels not drawn are zero
+            rows.append((f"RMS {c.replace('_', ' ')}", f"{num(float(v) * 1e3, 3)} mm"))
+    return rows
+
+
 def _scene(ds: Any) -> tuple[list[tuple[str, list[tuple[str, str]]]], dict[str, Any] | None]:
+    irregular = _irregularity(ds)
     try:
         d = json.loads(ds.attrs.get("scene_json", ""))
     except ValueError:
-        return [], None
+        return ([("track.irregularities", irregular)] if irregular else []), None
     if not isinstance(d, dict):
-        return [], None
+        return ([("track.irregularities", irregular)] if irregular else []), None
     sections, track = [], None
     for section, body in d.items():
         if section == "scene" or not isinstance(body, dict):
@@ -350,10 +393,14 @@ def _scene(ds: Any) -> tuple[list[tuple[str, list[tuple[str, str]]]], dict[str, 
             if section == "track" and k == "rows" and isinstance(v, list):
                 track = _track(v)
                 continue
+            if section == "track" and k == "irregularities":
+                continue  # said from the run's record below (defaults filled in, RMS)
             key = _SCENE_NAMES.get(k, k.replace("_", " "))
             rows.append((key, _scene_value(k, v)))
         if rows:
             sections.append((section, rows))
+    if irregular:
+        sections.append(("track.irregularities", irregular))
     return sections, track
 
 

@@ -43,6 +43,7 @@ __all__ = [
     "Statistic",
     "after_settling",
     "extreme",
+    "irregularity_spec",
     "load",
     "peaks",
     "save",
@@ -68,6 +69,13 @@ VARIABLES: dict[str, tuple[tuple[str, ...], str, str, str, dict[str, str]]] = {
     "coupler_force": (("coupler",), "N", "car", "coupler force", {"sign": "positive in tension"}),
     "tank_station": (("car",), "m", "track", "arc length of the tank centre along the track", {}),
     "tank_speed": (("car",), "m/s", "global", "tank speed", {}),
+    "car_acceleration": (
+        ("car", "component"),
+        "m/s2",
+        "car",
+        "acceleration of the car body (tank centre), gravity not included",
+        {"recorded_as": "load channel (load_filter)"},
+    ),
     # fluid vehicle runs
     "oil_com_tank": (("car", "component"), "m", "tank", "liquid centre of mass", {}),
     "oil_com_global": (("car", "component"), "m", "global", "liquid centre of mass", {}),
@@ -138,12 +146,88 @@ def _scene_attrs(sc: Any) -> dict[str, Any]:
     return attrs
 
 
+def _irregularity(irr: Any) -> tuple[dict[str, Any], dict[str, Any], dict[str, Any]]:
+    """The variables, coordinate and global attributes of a run's track irregularity
+    (:class:`railslosh.irregularity.Irregularity`): ``irregularity_<channel>`` on the ``distance``
+    dimension (m), and its :meth:`~railslosh.irregularity.Irregularity.summary` as
+    ``irregularity_<key>`` attributes (``rms`` as ``irregularity_rms_<channel>``, ``defects`` as
+    JSON text)."""
+    from railslosh.irregularity import CHANNELS, MEANINGS, Irregularity
+
+    if not isinstance(irr, Irregularity):
+        return {}, {}, {}
+    data_vars = {
+        f"irregularity_{c}": (
+            ("distance",),
+            np.asarray(getattr(irr, c)),
+            {"units": "m", "long_name": f"track irregularity, {MEANINGS[c][0]}", "sign": MEANINGS[c][1],
+             "frame": "track"},
+        )
+        for c in CHANNELS
+    }  # fmt: skip
+    coords = {
+        "distance": ("distance", irr.distance, {"units": "m", "long_name": "distance along the track (arc length s)"})
+    }
+    attrs: dict[str, Any] = {}
+    for k, v in irr.summary().items():
+        key = f"irregularity_{k}"
+        if k == "rms":
+            attrs |= {f"{key}_{c}": float(x) for c, x in v.items()}
+        elif k == "defects":
+            attrs[key] = json.dumps(v)
+        elif k == "channels":
+            attrs[key] = ",".join(v)
+        elif isinstance(v, bool):
+            attrs[key] = int(v)
+        elif isinstance(v, str | int | float):
+            attrs[key] = v
+        elif isinstance(v, list | tuple) and all(isinstance(x, int | float) for x in v):
+            attrs[key] = np.asarray(v, dtype=float)
+        elif v is not None:
+            attrs[key] = json.dumps(v, default=str)
+    return data_vars, coords, attrs
+
+
+def irregularity_spec(ds: Any) -> dict[str, Any] | None:
+    """The track irregularity a results Dataset records (:func:`to_dataset`), back as a dict:
+    ``kind``, ``class``, ``seed``, ``wavelengths``, ``taper``, ``start``, ``length``, ``step``,
+    ``channels``, ``file``, ``units``, ``sha256``, ``defects``, ``first``/``last`` distance,
+    ``samples`` and ``rms`` (per channel) as far as the run had them; ``None`` without one."""
+    a = ds.attrs
+    if "irregularity_kind" not in a:
+        return None
+    out: dict[str, Any] = {}
+    rms: dict[str, float] = {}
+    for k, v in a.items():
+        if not k.startswith("irregularity_"):
+            continue
+        key = k[len("irregularity_") :]
+        if key.startswith("rms_"):
+            rms[key[4:]] = float(v)
+        elif key == "defects":
+            out[key] = json.loads(v)
+        elif key == "channels":
+            out[key] = [c for c in str(v).split(",") if c]
+        elif isinstance(v, np.ndarray):
+            out[key] = [float(x) for x in v]
+        elif isinstance(v, np.generic):
+            out[key] = v.item()
+        else:
+            out[key] = v
+    if rms:
+        out["rms"] = rms
+    return out
+
+
 def to_dataset(res: Mapping[str, Any], scene: Any = None) -> Any:
     """The time series of a run (the dict of :func:`railslosh.vehicle.run`, ``run_fluid``,
     :func:`railslosh.slosh.run` or :func:`railslosh.scene.run_scene`) as an ``xarray.Dataset``
     with dimension ``time`` (s) and, as needed, ``wheelset``, ``side``, ``coupler``, ``car`` and
     ``component`` (x, y, z). Every variable has ``units``, ``long_name`` and ``frame`` attributes;
-    solver statistics and scalars (``static_wheel_load``, ``fluid_mass``, ...) are global attributes."""
+    solver statistics and scalars (``static_wheel_load``, ``fluid_mass``, ...) are global attributes.
+    A run on an irregular track (``res["irregularity"]``) adds its samples as ``irregularity_vertical``,
+    ``irregularity_alignment``, ``irregularity_cross_level``, ``irregularity_gauge`` (m) on the
+    ``distance`` dimension and its spec as ``irregularity_*`` attributes (:func:`irregularity_spec`)."""
     import xarray as xr
 
     from railslosh import __version__
@@ -202,6 +286,10 @@ def to_dataset(res: Mapping[str, Any], scene: Any = None) -> Any:
     if res.get("settled_start"):
         attrs["settled_start"] = 1
     attrs |= _scene_attrs(scene if scene is not None else res.get("scene"))
+    irr_vars, irr_coords, irr_attrs = _irregularity(res.get("irregularity"))
+    data_vars |= irr_vars
+    coords |= irr_coords
+    attrs |= irr_attrs
     return xr.Dataset(data_vars, coords=coords, attrs=attrs)
 
 

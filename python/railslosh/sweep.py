@@ -10,7 +10,9 @@ bulkheads x speed, or any scene field) is one run; the results are gathered into
 Grid names: ``oil`` (``fluid.oil``), ``fill`` (``fluid.fill``), ``braking`` (``ecp`` / ``all`` or
 ``conventional`` / ``front``: ``brake.scope``), ``bulkheads`` (number of equally spaced 20 mm
 bulkheads: ``tank.bulkheads``), ``speed`` (km/h: ``train.speed_kmh``, or the maneuver speed of a
-slosh scene), or any dotted scene field ``section.key``. Runs are distributed with
+slosh scene), ``track_class`` (the FRA class of ``[track.irregularities]``), ``model``
+(``fluid.slosh_model``: ``auto``, ``ancf``, ``pendulum``, ``rigid``), or any dotted scene field
+``section.key`` (or ``track.irregularities.key``). Runs are distributed with
 ``dask.distributed``: a ``LocalCluster`` by default (threads: the Rust solver releases the GIL),
 or the scheduler at ``address`` (its workers need railslosh installed).
 """
@@ -38,6 +40,8 @@ ALIASES = {
     "braking": "brake.scope",
     "bulkheads": "tank.bulkheads",
     "speed": "train.speed_kmh",
+    "track_class": "track.irregularities.class",
+    "model": "fluid.slosh_model",
 }
 """Short grid names and the scene field each sets."""
 

@@ -97,9 +97,11 @@ def _python_cases() -> dict[str, Case]:
     """Cases implemented in Python (name -> (description, run(quick) -> records))."""
     from railslosh.cosim.cases import PY_CASES
     from railslosh.fmu import FMU_CASES
+    from railslosh.irregularity import VALIDATION_CASES as IRREGULARITY_CASES
     from railslosh.swri_cases import SWRI_CASES
 
-    return {name: Case(name, desc, fn) for name, (desc, fn) in {**PY_CASES, **FMU_CASES, **SWRI_CASES}.items()}
+    cases = {**PY_CASES, **FMU_CASES, **SWRI_CASES, **IRREGULARITY_CASES}
+    return {name: Case(name, desc, fn) for name, (desc, fn) in cases.items()}
 
 
 CASES.update(_python_cases())

@@ -16,6 +16,7 @@ left; coupler forces are positive in tension.
 
 from __future__ import annotations
 
+import numbers
 import os
 from collections.abc import Sequence
 from typing import Any
@@ -23,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from railslosh import _core, limits
+from railslosh.irregularity import CLEARANCE, Irregularity
 from railslosh.progress import ProgressArg
 from railslosh.progress import callback as progress_callback
 from railslosh.slosh import SimulationError
@@ -39,12 +41,51 @@ __all__ = [
     "run_equivalent",
     "run_fluid",
     "tank_car_parameters",
+    "wheelset_stations",
 ]
 
 
 def tank_car_parameters(car: dict[str, float] | None = None, wheel_profile: str = "s1002") -> dict[str, float]:
     """Default (or overridden) scalar parameters of the tank car, its total mass and DOF count."""
     return dict(_core.tank_car_parameters(car, wheel_profile))
+
+
+def wheelset_stations(cars: int = 1, station: float = 50.0, car: dict[str, float] | None = None) -> np.ndarray:
+    """Track positions (arc length s, m) of every wheelset at t = 0, front to rear over all cars:
+    car k's tank centre is at ``station - k (2 coupler_reach + 1)``, its bogie centres at
+    ± ``truck_centers``/2 and the wheelsets at ± ``wheelbase``/2 about them
+    (``rail_mbs::vehicle::build_train``, ``add_tank_car``)."""
+    p = tank_car_parameters(car)
+    pitch = 2.0 * p["coupler_reach"] + 1.0
+    half, wb = 0.5 * p["truck_centers"], 0.5 * p["wheelbase"]
+    offsets = (half + wb, half - wb, -half + wb, -half - wb)
+    return np.array([station - k * pitch + o for k in range(int(cars)) for o in offsets], dtype=float)
+
+
+def _irregularity(
+    irregularity: Irregularity | dict[str, Any] | None, cars: int, station: float, car: dict[str, float] | None
+) -> tuple[dict[str, Any] | None, Irregularity | None]:
+    """The samples dict for the kernels and the :class:`railslosh.irregularity.Irregularity`
+    (``None``, ``None`` without one), checked to be zero under the train at t = 0."""
+    if irregularity is None:
+        return None, None
+    irr = irregularity if isinstance(irregularity, Irregularity) else Irregularity.from_dict(irregularity)
+    if isinstance(cars, bool) or not isinstance(cars, numbers.Integral) or cars < 1:
+        return irr.to_dict(), irr  # the kernels refuse the train with their own message
+    if isinstance(station, bool) or not isinstance(station, numbers.Real):
+        return irr.to_dict(), irr
+    lead = float(wheelset_stations(cars, station, car)[0])
+    clear = irr.clear_until()
+    if clear < lead + CLEARANCE:
+        where = "everywhere (its first sample is not zero)" if clear == -float("inf") else f"from {clear:.6g} m"
+        raise limits.invalid(
+            "irregularity",
+            {k: v for k, v in irr.spec.items() if k != "defects"},
+            f"a track that is perfect under the train at t = 0, up to {CLEARANCE:g} m ahead of the leading "
+            f"wheelset at {lead:.6g} m; it is irregular {where}: start the irregular section (and its taper) "
+            f"at {lead + CLEARANCE:.6g} m or beyond",
+        )
+    return irr.to_dict(), irr
 
 
 def _table(track: Any) -> list[list[float]]:
@@ -84,6 +125,7 @@ def _raise_on_error(res: dict[str, Any], what: str) -> dict[str, Any]:
 def run(
     track: Any,
     *,
+    irregularity: Irregularity | dict[str, Any] | None = None,
     cars: int = 1,
     station: float = 50.0,
     speed: float = 0.0,
@@ -123,14 +165,22 @@ def run(
     (-3 dB at ``0.32/record_every``, 16 Hz at 0.02 s; impulses preserved), or ``"sample"``: the value
     at the recording time, which aliases contact ringing above the record's Nyquist frequency.
 
+    ``irregularity`` (a :class:`railslosh.irregularity.Irregularity` or its samples dict) displaces
+    the rails in the wheel/rail contact (``docs/frames.md``, "Track irregularities"); it must be zero
+    under the train at t = 0, up to :data:`railslosh.irregularity.CLEARANCE` ahead of the leading
+    wheelset (:func:`wheelset_stations`), else ``ValueError``. The result keeps it as
+    ``"irregularity"`` (its ``spec`` and samples go into the results' attributes and variables).
+
     Raises ``ValueError`` naming a bad field, and :class:`railslosh.slosh.SimulationError` (with
     ``.results`` up to the failure) when the run stops early.
     """
     drive_speed, times, torques = _drive_and_brake(drive, speed, brake)
+    samples, irr = _irregularity(irregularity, cars, station, car)
     with progress_callback(progress, "vehicle run") as on_progress:
         res = dict(
             _core.run_train(
                 _table(track),
+                irregularity=samples,
                 cars=cars,
                 station=station,
                 speed=speed,
@@ -154,6 +204,8 @@ def run(
             )
         )
     res["load_filter"] = load_filter
+    if irr is not None:
+        res["irregularity"] = irr
     return _raise_on_error(res, "vehicle run")
 
 
@@ -169,6 +221,7 @@ def design_brake_torque(
 def run_fluid(
     track: Any,
     *,
+    irregularity: Irregularity | dict[str, Any] | None = None,
     cars: int = 1,
     station: float = 300.0,
     speed: float = 0.0,
@@ -202,19 +255,21 @@ def run_fluid(
     the run-time invariants per car and sample (``containment_gap`` in m, ``min_volume_ratio``,
     ``energy_error``; worst values in ``margins``) and ``snapshots`` (``[(t, [nodes x 4 x 3 per
     car])]``, position then gradients per node).
-    ``progress`` and ``stream`` work as in :func:`run`. ``wall_damping_ratio`` (0 to 10, default
-    :data:`WALL_DAMPING_RATIO`) is the damping ratio of the liquid column on the penalty wall
-    spring: 1 (critical) removes most of the 20-30 Hz wall ringing from the loads after a wave
+    ``progress``, ``stream`` and ``irregularity`` work as in :func:`run`. ``wall_damping_ratio`` (0 to
+    10, default :data:`WALL_DAMPING_RATIO`) is the damping ratio of the liquid column on the penalty
+    wall spring: 1 (critical) removes most of the 20-30 Hz wall ringing from the loads after a wave
     hits a head, at about 1.35x the run time (docs/validation.md, "Wall damping"). ``fill`` is the
     liquid volume fraction, :data:`railslosh.limits.FILL` (0.03 to 0.97, as in scenes).
     """
     fill = limits.check("fill", fill)
     wall_damping_ratio = limits.check("wall_damping_ratio", wall_damping_ratio)
     drive_speed, times, torques = _drive_and_brake(drive, speed, brake)
+    samples, irr = _irregularity(irregularity, cars, station, car)
     with progress_callback(progress, "vehicle run") as on_progress:
         res = dict(
             _core.run_fluid_train(
                 _table(track),
+                irregularity=samples,
                 cars=cars,
                 station=station,
                 speed=speed,
@@ -242,6 +297,8 @@ def run_fluid(
         )
     res["load_filter"] = load_filter
     res["wall_damping_ratio"] = wall_damping_ratio
+    if irr is not None:
+        res["irregularity"] = irr
     return _raise_on_error(res, "fluid vehicle run")
 
 
@@ -279,6 +336,7 @@ def equivalent_model(
 def run_equivalent(
     track: Any,
     *,
+    irregularity: Irregularity | dict[str, Any] | None = None,
     cars: int = 1,
     station: float = 300.0,
     speed: float = 0.0,
@@ -305,19 +363,22 @@ def run_equivalent(
     """Run tank cars whose liquid is its equivalent mechanical model: per compartment one slosh mass
     on a spring (``slosh_axis = "longitudinal"``, braking) or one pendulum hinged on the tank axis
     (``"lateral"``, curving), the rest of the liquid carried rigidly (see :func:`equivalent_model`).
-    Arguments as :func:`run_fluid` (``fill`` is the volume fraction; ``fluid`` gives density and plastic
-    viscosity, yield stresses are ignored). Returns the arrays of :func:`run` plus ``oil_com_tank``
-    (samples, cars, 3; liquid centre of mass in the tank frame, as :func:`run_fluid`),
+    Arguments as :func:`run_fluid` (``irregularity`` as :func:`run`; ``fill`` is the volume fraction;
+    ``fluid`` gives density and plastic viscosity, yield stresses are ignored). Returns the arrays of
+    :func:`run` plus ``oil_com_tank`` (samples, cars, 3; liquid centre of mass in the tank frame, as
+    :func:`run_fluid`),
     ``slosh_displacement`` (samples, cars, modes; m, along the slosh axis), ``fluid_mass`` and
     ``equivalent_model``."""
     if slosh_axis not in SLOSH_AXES:
         raise ValueError(f"invalid `slosh_axis` = {slosh_axis!r}: expected one of {', '.join(SLOSH_AXES)}")
     fill = limits.check("fill", fill)
     drive_speed, times, torques = _drive_and_brake(drive, speed, brake)
+    samples, irr = _irregularity(irregularity, cars, station, car)
     with progress_callback(progress, "vehicle run") as on_progress:
         res = dict(
             _core.run_equivalent_train(
                 _table(track),
+                irregularity=samples,
                 cars=cars,
                 station=station,
                 speed=speed,
@@ -344,6 +405,8 @@ def run_equivalent(
             )
         )
     res["load_filter"] = load_filter
+    if irr is not None:
+        res["irregularity"] = irr
     return _raise_on_error(res, "equivalent-slosh vehicle run")
 
 

@@ -15,7 +15,12 @@ otherwise (``_kmh``, ``_mph``, ``_ft``, ``_in``, ``_percent``; see ``docs/frames
 (Table 1 of seed 000: two opposite 3-degree curves with 3 in super-elevation and spirals, 2800 ft;
 or a straight track of ``length`` m), ``rows`` (SI segment table ``[s, curvature, superelevation,
 grade, cant_right, cant_left]``, 3 to 6 numbers a row) or ``us_rows`` (ft, arc-definition degrees
-positive to the left, in, %, rad). ``[train]``: ``cars``, ``station`` (front tank centre at t = 0),
+positive to the left, in, %, rad). ``[track.irregularities]``: the rails' irregularity
+(:mod:`railslosh.irregularity`): ``kind = "fra"`` (with ``class``), ``"erri_low"``, ``"erri_high"``,
+``"file"`` or ``"perfect"``, ``seed``, ``wavelengths``, ``taper``, ``start`` (≥ 1 m ahead of the
+leading wheelset at t = 0; default 10 m), ``length``, ``step``, ``channels``, ``file``, ``units``,
+``sha256``, ``defects`` (:meth:`Scene.irregularity_spec` fills in the defaults; ``--set
+track.irregularities.seed=2`` reaches its keys). ``[train]``: ``cars``, ``station`` (front tank centre at t = 0),
 ``speed`` or ``speed_kmh``, ``drive`` (``true`` holds the front car to ``speed``, a number to that
 speed), ``t_end``, ``step``, ``record_every``, ``load_filter`` (``"hat_mean"``: loads as their
 anti-aliased hat-weighted mean over the steps, or ``"sample"``; see :func:`railslosh.vehicle.run`),

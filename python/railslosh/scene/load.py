@@ -30,7 +30,9 @@ def _is_path(source: str | os.PathLike[str]) -> bool:
 def read_scene(source: str | os.PathLike[str] | Mapping[str, Any]) -> dict[str, Any]:
     """The parsed document of a scene file (path), TOML text or dict. A path that does not exist
     raises ``FileNotFoundError``, a directory ``IsADirectoryError``; TOML syntax, non-UTF-8 text
-    and an empty scene raise ``ValueError`` saying so."""
+    and an empty scene raise ``ValueError`` saying so. A scene file's relative
+    ``[track.irregularities] file`` is made relative to the scene file's folder (from text or a
+    dict it stays relative to the working directory)."""
     if isinstance(source, Mapping):
         data = dict(source)
         if not data:
@@ -60,7 +62,18 @@ def read_scene(source: str | os.PathLike[str] | Mapping[str, Any]) -> dict[str, 
     if not data:
         shown = str(source) if where else text
         raise invalid("scene", shown, f"{_KINDS}; the {'file' if where else 'text'} is empty (no sections)")
+    if where:
+        _relative_to(data, Path(source).parent)
     return data
+
+
+def _relative_to(data: dict[str, Any], folder: Path) -> None:
+    """A relative ``[track.irregularities] file`` of a scene file is relative to its folder."""
+    irr = data.get("track", {}).get("irregularities") if isinstance(data.get("track"), dict) else None
+    if isinstance(irr, dict) and isinstance(irr.get("file"), str) and irr["file"]:
+        p = Path(irr["file"]).expanduser()
+        if not p.is_absolute():
+            irr["file"] = str(folder / p)
 
 
 def load_scene(
@@ -92,13 +105,21 @@ def parse_value(text: str) -> Any:
         return text.strip()
 
 
+NESTED = (("track", "irregularities"),)
+"""Tables inside a section whose keys ``--set`` and ``--grid`` reach as ``section.table.key``."""
+
+
 def set_dotted(over: dict[str, Any], dotted: str, value: Any, option: str = "--set") -> None:
-    """Sets ``over[section][key] = value`` for ``dotted = "section.key"``; ``option`` names the
-    source in the error."""
+    """Sets ``over[section][key] = value`` for ``dotted = "section.key"`` (``over[section][table][key]``
+    for ``"track.irregularities.key"``, :data:`NESTED`); ``option`` names the source in the error."""
     keys = dotted.strip().split(".")
-    if len(keys) != 2 or not all(keys):
-        raise invalid(option, dotted, "a field section.key (e.g. train.t_end)")
-    over.setdefault(keys[0], {})[keys[1]] = value
+    nested = len(keys) == 3 and tuple(keys[:2]) in NESTED
+    if not (len(keys) == 2 or nested) or not all(keys):
+        raise invalid(option, dotted, "a field section.key (e.g. train.t_end) or track.irregularities.key")
+    node = over
+    for k in keys[:-1]:
+        node = node.setdefault(k, {})
+    node[keys[-1]] = value
 
 
 def parse_overrides(items: Iterable[str], option: str = "--set") -> dict[str, Any]:

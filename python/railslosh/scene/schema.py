@@ -18,7 +18,7 @@ from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from railslosh import _core, mesh
+from railslosh import _core, irregularity, mesh
 from railslosh.constants import MPH
 from railslosh.fluid_model import SLOSH_MODELS
 from railslosh.limits import FILL, PARAMETERS, Limit, invalid, unknown
@@ -41,6 +41,9 @@ TANK_SHAPES = ("elliptic", "cylinder", "box")
 MANEUVERS = ("lane_change", "bump", "pulse", "samples")
 """Names accepted by ``[maneuver] type``."""
 BUMP_SHAPES = ("half_round", "trapezoid")
+IRREGULARITY_KINDS = (*irregularity.SPECTRA, "file", "perfect")
+"""Values of ``[track.irregularities] kind``: a spectrum (:data:`railslosh.irregularity.SPECTRA`), a
+measured file, or a perfect track carrying only the defects."""
 MAX_SPEED = 70.0
 """Largest train or maneuver speed, m/s (252 km/h)."""
 MAX_ROWS = 10_000
@@ -177,6 +180,81 @@ SCHEMA: dict[str, dict[str, dict[str, Field]]] = {
                 "segment table in US units (arc-definition degrees, positive = curve to the left)",
             ),
             "length": _num(100.0, 1e6, "m", "a length", 3000.0, 'length of preset = "tangent" (only there)'),
+        },
+        "track.irregularities": {
+            "kind": _choice(
+                IRREGULARITY_KINDS,
+                None,
+                'the rails\' irregularity (required): a spectrum, US FRA track class ("fra" with `class`) or ERRI '
+                'B176 ("erri_low" good, "erri_high" poor track; no gauge spectrum), a measured "file", or a '
+                '"perfect" track carrying only the `defects` (railslosh.irregularity; channels in docs/frames.md)',
+            ),
+            "class": _int(
+                1,
+                6,
+                None,
+                'FRA track class, 1 (worst) to 6 (best); kind = "fra" only, required there',
+                "an FRA track class",
+            ),  # fmt: skip
+            "seed": _int(0, 999_999, 1, "seed of the random phases (spectra): the same seed gives the same track"),
+            "wavelengths": _value(
+                "[shortest, longest] (m, 0 < shortest < longest ≤ length)",
+                "wavelength range drawn from the spectrum",
+                [1.0, 70.0],
+            ),
+            "taper": _num(
+                0.0, 1e4, "m", "a length", 20.0, "raised-cosine ramp from zero at `start` (spectra)", lo_open=True
+            ),
+            "start": _num(
+                -1e6,
+                1e6,
+                "m",
+                "a track position",
+                None,
+                "where the irregular section (or the file's first row) starts: ≥ 1 m ahead of the leading wheelset at "
+                "t = 0, so that the train starts on perfect track",
+                default_doc="10 m ahead of the leading wheelset at t = 0",
+            ),
+            "length": _num(
+                0.0,
+                5e4,
+                "m",
+                "a length",
+                None,
+                "length of the irregular section (spectra, perfect)",
+                default_doc="speed × t_end + train length + 50 m rounded up to a whole km (a shorter t_end keeps "
+                "the track)",
+                lo_open=True,
+            ),
+            "step": _num(
+                1e-3,
+                10.0,
+                "m",
+                "a sample spacing",
+                None,
+                "sample spacing (spectra: ≤ half the shortest wavelength; defects span ≥ 8 steps)",
+                default_doc='`0.25` (`0.05` with kind = "perfect")',
+            ),
+            "channels": _value(
+                '["vertical", "alignment", "cross_level", "gauge"] (a subset)',
+                "the channels drawn or kept from the file; the others are zero",
+                default_doc="all four",
+            ),
+            "file": Field(
+                "text",
+                'measured irregularity file (kind = "file", required; format: railslosh.irregularity); a relative '
+                "path is relative to the scene file",
+            ),
+            "units": _choice(
+                irregularity.UNITS, None, "the file's channel units; must agree with its `# units:` line if it has one"
+            ),
+            "sha256": Field("text", "SHA-256 (hex) the file must have: a changed file is refused"),
+            "defects": _value(
+                '[{type = "cosine_dip", start, length, depth}, {type = "cusp", at, length, depth}, '
+                '{type = "twist", start, base, cross_level, hold}, ...] (m)',
+                "isolated defects added on top: within the section, each spanning ≥ 8 steps (depth positive down)",
+                [],
+            ),
         },
         "train": {
             "cars": _int(1, 50, 1, "number of tank cars", "a number of cars"),
@@ -344,8 +422,9 @@ key of the two kinds of scene."""
 
 
 def sections(kind: str) -> tuple[str, ...]:
-    """The sections of a ``"vehicle"`` or ``"slosh"`` scene."""
-    return tuple(s for s in SCHEMA[kind] if ":" not in s)
+    """The top-level sections of a ``"vehicle"`` or ``"slosh"`` scene (not the tables inside one,
+    ``track.irregularities``)."""
+    return tuple(s for s in SCHEMA[kind] if ":" not in s and "." not in s)
 
 
 def section_keys(kind: str, name: str) -> tuple[str, ...]:
@@ -404,7 +483,11 @@ class Section:
 
     def __init__(self, kind: str, name: str, doc: Mapping[str, Any], extra: Iterable[str] = ()) -> None:
         self.kind, self.name = kind, name
-        self.values = table(doc.get(name, {}), name)
+        parts = name.split(".")  # a table inside a section: "track.irregularities"
+        node: Any = doc.get(parts[0], {})
+        for k, part in enumerate(parts[1:], 1):
+            node = table(node, ".".join(parts[:k])).get(part, {})
+        self.values = table(node, name)
         check_keys(self.values, name, (*section_keys(kind, name), *extra))
 
     def __contains__(self, key: str) -> bool:
