@@ -4,42 +4,14 @@
 use std::sync::Arc;
 
 use nalgebra::{Matrix3, Vector3};
-use rail_mbs::profile::{s1002_wheel, uic60_rail};
+use rail_mbs::profile::uic60_rail;
 use rail_mbs::track::Side;
-use rail_mbs::wheel_rail::{FrictionMap, RailGeometry, RailPath, WheelGeometry, WheelPose, WheelRailContact};
+mod common;
+use common::contact::{height_for_load, s1002_on_uic60};
+use rail_mbs::wheel_rail::{FrictionMap, RailPath, WheelPose, WheelRailContact};
 
 fn right_wheel() -> WheelRailContact {
-    let rail = uic60_rail(2e-4).unwrap();
-    let offset = RailGeometry::offset_for_gauge(&rail, 1.435, 0.014).unwrap();
-    WheelRailContact::new(
-        WheelGeometry {
-            profile: s1002_wheel(2e-4).unwrap(),
-            nominal_radius: 0.46,
-            profile_offset: 0.75,
-            side: Side::Right,
-        },
-        RailGeometry {
-            profile: rail,
-            side: Side::Right,
-            profile_offset: offset,
-            vertical_offset: 0.0,
-            path: RailPath::Straight { inward_cant: 1.0 / 40.0 },
-        },
-    )
-}
-
-fn height_for_load(c: &mut WheelRailContact, pose: &WheelPose, fz: f64) -> f64 {
-    let mut p = *pose;
-    let mut f = |z: f64| {
-        p.position.z = z;
-        c.evaluate(&p).unwrap().iter().map(|q| q.force_on_wheel().z).sum::<f64>()
-    };
-    let (mut lo, mut hi) = (pose.position.z - 0.01, pose.position.z + 0.01);
-    for _ in 0..60 {
-        let m = 0.5 * (lo + hi);
-        if f(m) > fz { lo = m } else { hi = m }
-    }
-    0.5 * (lo + hi)
+    s1002_on_uic60(Side::Right, RailPath::Straight { inward_cant: 1.0 / 40.0 })
 }
 
 #[test]
@@ -50,7 +22,7 @@ fn each_patch_saturates_at_the_friction_of_its_own_location() {
     for i in 0..=70 {
         let y = -0.0048 - 2e-5 * i as f64;
         let pose = WheelPose::at_rest(Vector3::new(0.0, y, 0.46), Matrix3::identity());
-        let z = height_for_load(&mut c, &pose, 1e4);
+        let z = height_for_load(&mut c, &pose, 1e4, 0.01);
         let pose = WheelPose { position: Vector3::new(0.0, y, z), ..pose };
         let pts = c.evaluate(&pose).unwrap();
         if pts.len() == 2 && pts.iter().all(|p| p.normal_force > 500.0) {

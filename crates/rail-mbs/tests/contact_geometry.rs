@@ -4,8 +4,10 @@
 use std::sync::Arc;
 
 use nalgebra::{Matrix3, Vector3};
-use rail_mbs::profile::{Profile, s1002_wheel, uic60_rail};
+use rail_mbs::profile::Profile;
 use rail_mbs::track::{Side, Track, TrackPoint};
+mod common;
+use common::contact::{height_for_load, s1002_on_uic60};
 use rail_mbs::wheel_rail::{
     ContactMethod, Material, RailGeometry, RailPath, WheelGeometry, WheelPose, WheelRailContact, combined_modulus,
 };
@@ -17,31 +19,6 @@ fn rot_z(a: f64) -> Matrix3<f64> {
 fn rot_x(a: f64) -> Matrix3<f64> {
     let (s, c) = a.sin_cos();
     Matrix3::new(1.0, 0.0, 0.0, 0.0, c, -s, 0.0, s, c)
-}
-
-fn s1002_on_uic60(side: Side, path: RailPath) -> WheelRailContact {
-    let rail = uic60_rail(2e-4).unwrap();
-    let offset = RailGeometry::offset_for_gauge(&rail, 1.435, 0.014).unwrap();
-    WheelRailContact::new(
-        WheelGeometry { profile: s1002_wheel(2e-4).unwrap(), nominal_radius: 0.46, profile_offset: 0.75, side },
-        RailGeometry { profile: rail, side, profile_offset: offset, vertical_offset: 0.0, path },
-    )
-}
-
-/// Wheelset height giving a vertical wheel force `fz`.
-fn height_for_load(c: &mut WheelRailContact, pose: &WheelPose, fz: f64) -> f64 {
-    let mut p = *pose;
-    let mut f = |z: f64| {
-        p.position.z = z;
-        c.evaluate(&p).unwrap().iter().map(|q| q.force_on_wheel().z).sum::<f64>()
-    };
-    let (mut lo, mut hi) = (pose.position.z - 0.01, pose.position.z + 0.01);
-    assert!(f(lo) > fz && f(hi) < fz, "bracket");
-    for _ in 0..60 {
-        let m = 0.5 * (lo + hi);
-        if f(m) > fz { lo = m } else { hi = m }
-    }
-    0.5 * (lo + hi)
 }
 
 #[test]
@@ -165,7 +142,7 @@ fn tread_and_flange_give_two_contact_points() {
     for i in 0..=70 {
         let y = -0.0048 - 2e-5 * i as f64;
         let pose = WheelPose::at_rest(Vector3::new(0.0, y, 0.46), Matrix3::identity());
-        let z = height_for_load(&mut c, &pose, 1e4);
+        let z = height_for_load(&mut c, &pose, 1e4, 0.01);
         let pts = c.evaluate(&WheelPose { position: Vector3::new(0.0, y, z), ..pose }).unwrap();
         counts.push(pts.len());
         if pts.len() >= 2 && found.is_none() {
@@ -199,7 +176,7 @@ fn separation_gives_no_force_and_warm_start_agrees() {
     let mut c = s1002_on_uic60(Side::Right, RailPath::Straight { inward_cant: 1.0 / 40.0 });
     // Wheelset 3 mm to the left: the right wheel runs on its tread (single point).
     let base = WheelPose::at_rest(Vector3::new(0.0, 0.003, 0.46), Matrix3::identity());
-    let z = height_for_load(&mut c, &base, 5e4);
+    let z = height_for_load(&mut c, &base, 5e4, 0.01);
     let loaded = c.evaluate(&WheelPose { position: Vector3::new(0.0, 0.003, z), ..base }).unwrap();
     assert_eq!(loaded.len(), 1);
     let cos_gamma = loaded[0].geometry.normal.z;

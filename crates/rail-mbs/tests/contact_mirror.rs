@@ -7,21 +7,12 @@
 use nalgebra::{Matrix3, Vector3};
 use rail_mbs::profile::{s1002_wheel, uic60_rail};
 use rail_mbs::track::Side;
+mod common;
+use common::contact::{height_for_load, s1002_on_uic60};
 use rail_mbs::wheel_rail::{RailGeometry, RailPath, WheelGeometry, WheelPose, WheelRailContact};
 
 fn contact(side: Side) -> WheelRailContact {
-    let rail = uic60_rail(2e-4).unwrap();
-    let offset = RailGeometry::offset_for_gauge(&rail, 1.435, 0.014).unwrap();
-    let mut c = WheelRailContact::new(
-        WheelGeometry { profile: s1002_wheel(2e-4).unwrap(), nominal_radius: 0.46, profile_offset: 0.75, side },
-        RailGeometry {
-            profile: rail,
-            side,
-            profile_offset: offset,
-            vertical_offset: 0.0,
-            path: RailPath::Straight { inward_cant: 1.0 / 40.0 },
-        },
-    );
+    let mut c = s1002_on_uic60(side, RailPath::Straight { inward_cant: 1.0 / 40.0 });
     c.settings.always_scan = true; // no warm start: each pose is found from scratch
     c
 }
@@ -62,22 +53,6 @@ fn resultant(c: &mut WheelRailContact, pose: &WheelPose) -> (Vector3<f64>, Vecto
     (f, m, n.into_iter().map(|x| x.1).collect())
 }
 
-/// The wheel-centre height at which the vertical contact force is `fz` (bisection).
-fn height_for_load(c: &mut WheelRailContact, pose: &WheelPose, fz: f64) -> f64 {
-    let mut p = *pose;
-    let mut f = |z: f64| {
-        p.position.z = z;
-        c.evaluate(&p).unwrap().iter().map(|q| q.force_on_wheel().z).sum::<f64>()
-    };
-    let (mut lo, mut hi) = (pose.position.z - 0.02, pose.position.z + 0.02);
-    assert!(f(lo) > fz && f(hi) < fz, "bracket");
-    for _ in 0..60 {
-        let mid = 0.5 * (lo + hi);
-        if f(mid) > fz { lo = mid } else { hi = mid }
-    }
-    0.5 * (lo + hi)
-}
-
 #[test]
 fn the_right_wheel_is_the_mirror_image_of_the_left_wheel_over_a_sweep_of_shifts() {
     let (mut left, mut right) = (contact(Side::Left), contact(Side::Right));
@@ -97,7 +72,7 @@ fn the_right_wheel_is_the_mirror_image_of_the_left_wheel_over_a_sweep_of_shifts(
                 angular_velocity: Vector3::new(0.0, v / r0 * 1.001, 0.0),
             };
             // the left wheel carrying 60 kN (the mirrored right wheel is then at that height too)
-            pose.position.z = height_for_load(&mut left, &pose, 6e4);
+            pose.position.z = height_for_load(&mut left, &pose, 6e4, 0.02);
             let (fl, ml, nl) = resultant(&mut left, &pose);
             let mp = mirror(&pose);
             let (fr, mr, nr) = resultant(&mut right, &mp);
@@ -142,7 +117,7 @@ fn the_contact_of_a_pose_does_not_depend_on_the_search_history() {
             velocity: Vector3::new(v, 0.05, 0.0),
             angular_velocity: Vector3::new(0.0, v / r0 * 1.001, 0.0),
         };
-        pose.position.z = height_for_load(&mut warm, &pose, 6e4); // leaves a history in `warm`
+        pose.position.z = height_for_load(&mut warm, &pose, 6e4, 0.02); // leaves a history in `warm`
         let a = warm.evaluate(&pose).unwrap();
         fresh.reset();
         let b = fresh.evaluate(&pose).unwrap();
@@ -199,7 +174,7 @@ fn the_contact_does_not_depend_on_where_the_track_lies() {
             velocity: Vector3::new(20.0, 0.05, 0.0),
             angular_velocity: Vector3::new(0.0, 20.0 / 0.46 * 1.001, 0.0),
         };
-        pose.position.z = height_for_load(&mut here, &pose, 6e4);
+        pose.position.z = height_for_load(&mut here, &pose, 6e4, 0.02);
         let moved = WheelPose { position: pose.position + shift, ..pose };
         let (fa, _, na) = resultant(&mut here, &pose);
         let (fb, _, nb) = resultant(&mut there, &moved);

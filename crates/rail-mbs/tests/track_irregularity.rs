@@ -5,24 +5,10 @@
 use std::sync::Arc;
 
 use nalgebra::{Matrix3, Vector3};
-use rail_mbs::profile::{s1002_wheel, uic60_rail};
 use rail_mbs::track::{Channel, Defect, Irregularity, Side, Track, TrackPoint};
-use rail_mbs::wheel_rail::{RailGeometry, RailPath, WheelGeometry, WheelPose, WheelRailContact};
-
-fn s1002_on_uic60(side: Side, track: Arc<Track>) -> WheelRailContact {
-    let rail = uic60_rail(2e-4).unwrap();
-    let offset = RailGeometry::offset_for_gauge(&rail, 1.435, 0.014).unwrap();
-    WheelRailContact::new(
-        WheelGeometry { profile: s1002_wheel(2e-4).unwrap(), nominal_radius: 0.46, profile_offset: 0.75, side },
-        RailGeometry {
-            profile: rail,
-            side,
-            profile_offset: offset,
-            vertical_offset: 0.0,
-            path: RailPath::Track(track),
-        },
-    )
-}
+mod common;
+use common::contact::s1002_on_uic60;
+use rail_mbs::wheel_rail::{RailPath, WheelPose, WheelRailContact};
 
 fn level_track() -> Track {
     Track::new(vec![
@@ -60,8 +46,8 @@ fn a_cosine_dip_shows_in_the_contact_point_height_as_the_wheel_rolls_over_it() {
     let dip = |s: f64| irr.value(Channel::Vertical, s);
     let perfect = Arc::new(level_track());
     let dipped = Arc::new(level_track().with_irregularity(irr.clone()));
-    let mut on_perfect = s1002_on_uic60(Side::Left, perfect);
-    let mut on_dipped = s1002_on_uic60(Side::Left, dipped);
+    let mut on_perfect = s1002_on_uic60(Side::Left, RailPath::Track(perfect));
+    let mut on_dipped = s1002_on_uic60(Side::Left, RailPath::Track(dipped));
     let y = 0.0015; // wheelset 1.5 mm to the left: a tread contact
     let mut deepest = 0.0_f64;
     let mut worst_point = 0.0_f64;
@@ -107,8 +93,8 @@ fn each_channel_moves_its_rail_as_documented() {
     assert_eq!(l.x, 0.0);
     // the contact sees the same rail: a wheel touching the moved right rail sits higher by
     // v + c/2 (no lateral change for the right rail here)
-    let mut c0 = s1002_on_uic60(Side::Right, Arc::new(level_track()));
-    let mut c1 = s1002_on_uic60(Side::Right, Arc::new(moved.clone()));
+    let mut c0 = s1002_on_uic60(Side::Right, RailPath::Track(Arc::new(level_track())));
+    let mut c1 = s1002_on_uic60(Side::Right, RailPath::Track(Arc::new(moved.clone())));
     let (z0, _) = touching(&mut c0, s, -0.0015);
     let (z1, _) = touching(&mut c1, s, -0.0015);
     assert!(((z1 - z0) - 0.005).abs() < 1e-9, "{}", z1 - z0);

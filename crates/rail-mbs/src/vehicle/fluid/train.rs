@@ -10,9 +10,11 @@ use ancf_core::mesh::{CylinderTankSpec, cylinder_tank, cylinder_tank_compartment
 use ancf_core::tank::{Bulkhead, TankGeometry, TankShape};
 
 use super::*;
-use crate::vehicle::run::{Observer, SampleSink, TrainRecord, TrainRun, TrainScenario, build_train, drive, record_sample};
-use crate::vehicle::tank_car::CarBodies;
 use crate::integrator::{Hht, IntegratorError};
+use crate::vehicle::run::{
+    Observer, SampleSink, TrainRecord, TrainRun, TrainScenario, build_train, drive, record_sample,
+};
+use crate::vehicle::tank_car::CarBodies;
 
 /// Liquid cargo of every car of a train: an ANCF fluid mesh of the car's tank
 /// (cylinder with half-ellipsoid heads 0.5 m deep, overall length `tank_length`).
