@@ -184,3 +184,63 @@ fn the_contact_does_not_depend_on_where_the_track_lies() {
     println!("track moved by {shift:?}: worst relative force difference {worst:.2e}");
     assert!(worst < 1e-9, "{worst}");
 }
+
+/// Largest distance (m) between the warm-started and the fresh contact points at the target
+/// shifts 0, 0.5, …, 10 mm of the left wheel (60 kN), the wheelset swept there in steps of
+/// `step` m with the search warm-started from step to step; and the number of targets whose
+/// point count differs.
+fn sweep_error(step: f64) -> (f64, usize) {
+    let mut warm = s1002_on_uic60(Side::Left, RailPath::Straight { inward_cant: 1.0 / 40.0 });
+    warm.settings.always_scan = true;
+    let mut fresh = contact(Side::Left);
+    let base = WheelPose {
+        position: Vector3::new(5.0, 0.0, 0.46),
+        rotation: Matrix3::identity(),
+        velocity: Vector3::new(20.0, 0.0, 0.0),
+        angular_velocity: Vector3::new(0.0, 20.0 / 0.46, 0.0),
+    };
+    let n = (0.010 / step).round() as usize;
+    let every = (0.0005 / step).round() as usize;
+    let (mut worst, mut count_differs) = (0.0f64, 0);
+    let mut z = 0.46;
+    for k in 0..=n {
+        let y = step * k as f64;
+        let mut pose = WheelPose { position: Vector3::new(5.0, y, z), ..base };
+        // the height for 60 kN from a fresh search (the same at every step size)
+        pose.position.z = height_for_load(&mut fresh, &pose, 6e4, 0.02);
+        z = pose.position.z;
+        let a = warm.evaluate(&pose).unwrap();
+        if k % every == 0 {
+            fresh.reset();
+            let b = fresh.evaluate(&pose).unwrap();
+            if a.len() != b.len() {
+                count_differs += 1;
+                continue;
+            }
+            for (p, q) in a.iter().zip(&b) {
+                worst = worst.max((p.point() - q.point()).norm());
+            }
+        }
+    }
+    (worst, count_differs)
+}
+
+#[test]
+fn the_warm_started_contact_point_converges_with_the_sweep_step() {
+    // Issue 21: sweeping the wheelset towards flange contact in finer and finer steps, the
+    // warm-started search must land on the fresh search's points at the shared shifts.
+    let mut rows = Vec::new();
+    for step in [5e-4, 2.5e-4, 1e-4, 5e-5] {
+        let (worst, differs) = sweep_error(step);
+        println!(
+            "step {:.3} mm: worst point distance {:.3e} m, {differs} of 21 shifts with another point count",
+            step * 1e3,
+            worst
+        );
+        rows.push((step, worst, differs));
+    }
+    for (step, worst, differs) in &rows {
+        assert_eq!(*differs, 0, "step {step}");
+        assert!(*worst < 1e-9, "step {step}: {worst}");
+    }
+}
