@@ -7,18 +7,12 @@
 //! "gauge": array}` (metres; signs in `docs/frames.md`).
 
 use numpy::{PyArray1, PyReadonlyArray1};
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use rail_mbs::track::{Channel, Defect, Irregularity, IrregularityPsd, TrackSpectrum};
 
-fn invalid(field: &str, value: impl std::fmt::Display, allowed: &str) -> PyErr {
-    PyValueError::new_err(format!("invalid `{field}` = {value}: expected {allowed}"))
-}
-
-fn to_py(e: rail_mbs::track::IrregularityError) -> PyErr {
-    PyValueError::new_err(e.to_string())
-}
+use crate::rail::invalid;
+use crate::to_py;
 
 /// The spectrum named `kind` ("fra" with `track_class` 1–6, "erri_low", "erri_high").
 fn spectrum(kind: &str, track_class: Option<i64>) -> PyResult<TrackSpectrum> {

@@ -40,7 +40,7 @@ fn detached<T: Send, F: FnOnce() -> T + Send>(py: Python<'_>, f: F) -> PyResult<
     crate::compute(py, move || Ok(f()))
 }
 
-fn invalid(field: &str, value: impl std::fmt::Display, allowed: &str) -> PyErr {
+pub(crate) fn invalid(field: &str, value: impl std::fmt::Display, allowed: &str) -> PyErr {
     PyValueError::new_err(format!("invalid `{field}` = {value}: expected {allowed}"))
 }
 
@@ -714,7 +714,7 @@ pub fn wheel_rail_contact<'py>(
     let friction_map = match friction_profile {
         Some(profile) => {
             let m = FrictionMap { profile, along_track: Vec::new() };
-            m.validate().map_err(|e| PyValueError::new_err(e.to_string()))?;
+            m.validate().map_err(contact_err)?;
             Some(Arc::new(m))
         }
         None => None,
@@ -854,7 +854,7 @@ pub fn lubricated_gauge_face(
 ) -> PyResult<Vec<(f64, f64)>> {
     FrictionMap::lubricated_gauge_face(&rail.inner, mu_top, mu_gauge, depth, width)
         .map(|m| m.profile)
-        .map_err(|e| PyValueError::new_err(e.to_string()))
+        .map_err(contact_err)
 }
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -36,8 +36,8 @@
 //! * **Isolated defects** ([`Defect`]) added on top: a cosine dip, a cusp (dipped joint) and a
 //!   cross-level twist over a base.
 
+use ancf_core::error::{AncfError, invalid};
 use ancf_core::validate::Rng;
-use thiserror::Error;
 
 use super::Side;
 
@@ -67,25 +67,6 @@ impl Channel {
             Channel::Gauge => "gauge",
         }
     }
-}
-
-/// Errors of building an irregularity.
-#[derive(Debug, Error, Clone, PartialEq)]
-pub enum IrregularityError {
-    /// A parameter outside its range.
-    #[error("invalid `{field}` = {value}: expected {allowed}")]
-    Invalid {
-        /// The parameter.
-        field: &'static str,
-        /// Its value, as given.
-        value: String,
-        /// The allowed range.
-        allowed: String,
-    },
-}
-
-fn invalid(field: &'static str, value: impl std::fmt::Display, allowed: impl Into<String>) -> IrregularityError {
-    IrregularityError::Invalid { field, value: value.to_string(), allowed: allowed.into() }
 }
 
 /// A one-sided track-irregularity spectrum.
@@ -125,7 +106,7 @@ const ERRI_B: f64 = 0.75;
 
 impl TrackSpectrum {
     /// Checks the class.
-    pub fn validate(&self) -> Result<(), IrregularityError> {
+    pub fn validate(&self) -> Result<(), AncfError> {
         match self {
             TrackSpectrum::Fra { class } if !(1..=6).contains(class) => {
                 Err(invalid("class", class, "an FRA track class 1–6"))
@@ -214,7 +195,7 @@ impl IrregularityPsd {
     }
 
     /// Checks the ranges.
-    pub fn validate(&self) -> Result<(), IrregularityError> {
+    pub fn validate(&self) -> Result<(), AncfError> {
         self.spectrum.validate()?;
         let (lo, hi) = self.wavelengths;
         if !self.start.is_finite() {
@@ -230,14 +211,18 @@ impl IrregularityPsd {
             return Err(invalid(
                 "wavelengths",
                 format!("[{lo}, {hi}]"),
-                format!("a longest wavelength ≤ the length {} m", self.length),
+                &format!("a longest wavelength ≤ the length {} m", self.length),
             ));
         }
         if !(self.step.is_finite() && self.step > 0.0 && self.step <= 0.5 * lo) {
-            return Err(invalid("step", self.step, format!("0 < step ≤ half the shortest wavelength, {} m", 0.5 * lo)));
+            return Err(invalid(
+                "step",
+                self.step,
+                &format!("0 < step ≤ half the shortest wavelength, {} m", 0.5 * lo),
+            ));
         }
         if !(self.taper.is_finite() && self.taper >= 0.0 && self.taper <= self.length) {
-            return Err(invalid("taper", self.taper, format!("0 ≤ taper ≤ the length {} m", self.length)));
+            return Err(invalid("taper", self.taper, &format!("0 ≤ taper ≤ the length {} m", self.length)));
         }
         Ok(())
     }
@@ -334,7 +319,7 @@ impl Defect {
         }
     }
 
-    fn validate(&self) -> Result<(), IrregularityError> {
+    fn validate(&self) -> Result<(), AncfError> {
         let ok = |v: f64| v.is_finite();
         match *self {
             Defect::CosineDip { start, length, depth } | Defect::Cusp { at: start, length, depth } => {
@@ -372,7 +357,7 @@ pub struct Irregularity {
 impl Irregularity {
     /// From samples on the uniform grid `start + k step`, one vector per channel in
     /// [`Channel::ALL`] order, all of the same length ≥ 2, finite.
-    pub fn from_samples(start: f64, step: f64, channels: [Vec<f64>; 4]) -> Result<Self, IrregularityError> {
+    pub fn from_samples(start: f64, step: f64, channels: [Vec<f64>; 4]) -> Result<Self, AncfError> {
         if !start.is_finite() {
             return Err(invalid("start", start, "a finite distance (m)"));
         }
@@ -388,7 +373,7 @@ impl Irregularity {
                 return Err(invalid(
                     c.name(),
                     format!("{} samples", x.len()),
-                    format!("{n} samples, as many as the others"),
+                    &format!("{n} samples, as many as the others"),
                 ));
             }
             if let Some(i) = x.iter().position(|v| !v.is_finite()) {
@@ -400,7 +385,7 @@ impl Irregularity {
 
     /// Draws the channels from a spectrum (module docs); the same parameters give the same
     /// track, bit for bit.
-    pub fn generate(p: &IrregularityPsd) -> Result<Self, IrregularityError> {
+    pub fn generate(p: &IrregularityPsd) -> Result<Self, AncfError> {
         p.validate()?;
         let n = (p.length / p.step).round() as usize + 1;
         let d_omega = 2.0 * std::f64::consts::PI / p.length;
@@ -440,9 +425,9 @@ impl Irregularity {
     }
 
     /// A perfect track sampled over [start, end] every `step` (for adding defects to).
-    pub fn zero(start: f64, end: f64, step: f64) -> Result<Self, IrregularityError> {
+    pub fn zero(start: f64, end: f64, step: f64) -> Result<Self, AncfError> {
         if !(end.is_finite() && start.is_finite() && end > start) {
-            return Err(invalid("end", end, format!("a distance > the start {start} m")));
+            return Err(invalid("end", end, &format!("a distance > the start {start} m")));
         }
         if !(step.is_finite() && step > 0.0) {
             return Err(invalid("step", step, "a sample spacing > 0 m"));
@@ -453,13 +438,13 @@ impl Irregularity {
 
     /// Adds `defect` to its channel at the grid points (the grid must hold at least 8
     /// samples over its shortest feature, and cover it).
-    pub fn add_defect(&mut self, defect: &Defect) -> Result<(), IrregularityError> {
+    pub fn add_defect(&mut self, defect: &Defect) -> Result<(), AncfError> {
         defect.validate()?;
         if defect.feature() < 8.0 * self.step {
             return Err(invalid(
                 "length",
                 defect.feature(),
-                format!("a defect feature ≥ 8 sample spacings, {} m (or a finer `step`)", 8.0 * self.step),
+                &format!("a defect feature ≥ 8 sample spacings, {} m (or a finer `step`)", 8.0 * self.step),
             ));
         }
         let (a, b) = defect.range();
@@ -467,7 +452,7 @@ impl Irregularity {
             return Err(invalid(
                 "defect",
                 format!("[{a}, {b}] m"),
-                format!("within the irregularity's range [{}, {}] m", self.start, self.end()),
+                &format!("within the irregularity's range [{}, {}] m", self.start, self.end()),
             ));
         }
         let c = defect.channel() as usize;

@@ -55,7 +55,7 @@ use nalgebra::{Matrix3, Vector3};
 use thiserror::Error;
 
 pub mod irregularity;
-pub use irregularity::{Channel, Defect, Irregularity, IrregularityError, IrregularityPsd, TrackSpectrum};
+pub use irregularity::{Channel, Defect, Irregularity, IrregularityPsd, TrackSpectrum};
 
 pub use ancf_core::constants::{FOOT, GRAVITY, INCH, MPH};
 /// Radius, in feet, of a 1° curve with the arc definition (100 ft of arc per degree).
@@ -530,7 +530,11 @@ impl Track {
     /// Point of the gauge line of one rail at `s` (centreline ± gauge/2 along the
     /// track-frame lateral axis, plus the rail's irregularity offset).
     pub fn rail_point(&self, s: f64, side: Side) -> Vector3<f64> {
-        let f = self.frame(s);
+        self.rail_point_in(&self.frame(s), s, side)
+    }
+
+    /// [`Track::rail_point`] in the already computed track frame `f` at `s`.
+    fn rail_point_in(&self, f: &TrackFrame, s: f64, side: Side) -> Vector3<f64> {
         let (dy, dz) = self.rail_offset(s, side);
         f.origin + f.lateral() * (side.sign() * 0.5 * self.gauge + dy) + f.up() * dz
     }
@@ -541,7 +545,7 @@ impl Track {
     /// rail).
     pub fn rail_frame(&self, s: f64, side: Side, offset: Vector3<f64>) -> TrackFrame {
         let f = self.frame(s);
-        let base = self.rail_point(s, side) + f.rotation * offset;
+        let base = self.rail_point_in(&f, s, side) + f.rotation * offset;
         let ang = side.sign() * self.rail_inward_cant(s, side);
         let (sa, ca) = ang.sin_cos();
         let rx = Matrix3::new(1.0, 0.0, 0.0, 0.0, ca, -sa, 0.0, sa, ca);

@@ -32,8 +32,9 @@ fn table(x: &[(f64, f64)], at: f64) -> f64 {
     a.1 + (b.1 - a.1) * (at - a.0) / (b.0 - a.0)
 }
 
+/// The project's one "invalid `field` = value: expected …" message, as a contact error.
 fn invalid(field: &str, value: impl std::fmt::Display, allowed: &str) -> ContactError {
-    ContactError::InvalidInput(format!("invalid `{field}` = {value}: expected {allowed}"))
+    ContactError::InvalidInput(ancf_core::error::invalid(field, value, allowed).to_string())
 }
 
 impl FrictionMap {
