@@ -628,31 +628,25 @@ impl WheelRailContact {
         for &(_, seed, ulo, uhi) in &seeds {
             // Prefer a previous solution close to this seed as the starting guess.
             let start = self.previous.iter().find(|p| (p[2] - seed[2]).abs() < 2e-3).copied().unwrap_or(seed);
-            let solved =
-                self.newton(pose, start).ok().filter(|q| self.in_domain(q) && (q[2] - seed[2]).abs() < 5e-3).or_else(
-                    || {
-                        if start != seed {
-                            self.newton(pose, seed).ok().filter(|q| self.in_domain(q) && (q[2] - seed[2]).abs() < 5e-3)
-                        } else {
-                            None
-                        }
-                    },
-                );
-            let newton_geo = solved
-                .map(|q| self.geometry_at(pose, q, ContactMethod::Newton))
-                .filter(|g| g.curvature_x > 0.0 && g.curvature_y > 0.0);
-            let g = match newton_geo {
+            // a Newton solution from `from` that stays in the domain near this seed, and its
+            // geometry when both relative curvatures are positive
+            let converged = |from: [f64; 4]| {
+                self.newton(pose, from).ok().filter(|q| self.in_domain(q) && (q[2] - seed[2]).abs() < 5e-3)
+            };
+            let convex = |q: [f64; 4]| {
+                Some(self.geometry_at(pose, q, ContactMethod::Newton))
+                    .filter(|g| g.curvature_x > 0.0 && g.curvature_y > 0.0)
+            };
+            let solved = converged(start).or_else(|| if start != seed { converged(seed) } else { None });
+            let g = match solved.and_then(convex) {
                 Some(g) => g,
                 None => {
                     let q = self.refine_scan(pose, s0, ulo, uhi);
                     // Newton once more from the refined scan point: when it converges the
                     // point is exact (and the same whichever start the search had), the scan
                     // point only approximate
-                    self.newton(pose, q)
-                        .ok()
-                        .filter(|q| self.in_domain(q) && (q[2] - seed[2]).abs() < 5e-3)
-                        .map(|q| self.geometry_at(pose, q, ContactMethod::Newton))
-                        .filter(|g| g.curvature_x > 0.0 && g.curvature_y > 0.0)
+                    converged(q)
+                        .and_then(convex)
                         .unwrap_or_else(|| self.geometry_at(pose, q, ContactMethod::ScanFallback))
                 }
             };
