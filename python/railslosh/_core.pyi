@@ -300,6 +300,7 @@ def wheel_rail_contact(
 # --- vehicle (crates/railslosh-py/src/vehicle.rs) ---
 
 def tank_car_parameters(car: dict[str, float] | None = None, wheel_profile: str = "s1002") -> dict[str, Any]: ...
+def wheelset_stations(cars: int = 1, station: float = 50.0, car: dict[str, float] | None = None) -> list[float]: ...
 def track_irregularity(
     kind: str,
     length: float,

@@ -51,15 +51,11 @@ def tank_car_parameters(car: dict[str, float] | None = None, wheel_profile: str 
 
 
 def wheelset_stations(cars: int = 1, station: float = 50.0, car: dict[str, float] | None = None) -> np.ndarray:
-    """Track positions (arc length s, m) of every wheelset at t = 0, front to rear over all cars:
-    car k's tank centre is at ``station - k (2 coupler_reach + 1)``, its bogie centres at
-    ± ``truck_centers``/2 and the wheelsets at ± ``wheelbase``/2 about them
-    (``rail_mbs::vehicle::build_train``, ``add_tank_car``)."""
-    p = tank_car_parameters(car)
-    pitch = 2.0 * p["coupler_reach"] + 1.0
-    half, wb = 0.5 * p["truck_centers"], 0.5 * p["wheelbase"]
-    offsets = (half + wb, half - wb, -half + wb, -half - wb)
-    return np.array([station - k * pitch + o for k in range(int(cars)) for o in offsets], dtype=float)
+    """Track positions (arc length s, m) of every wheelset at t = 0, front to rear over all cars whose
+    front tank centre is at ``station``: read off the train that ``rail_mbs::vehicle::build_train``
+    builds, so it is the runs' own placement (car k's tank centre at ``station - k (2 coupler_reach +
+    1)``, its bogie centres at ± ``truck_centers``/2, the wheelsets at ± ``wheelbase``/2 about them)."""
+    return np.asarray(_core.wheelset_stations(int(cars), float(station), car), dtype=float)
 
 
 def _irregularity(

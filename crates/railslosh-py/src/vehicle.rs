@@ -85,6 +85,29 @@ fn car_params(overrides: Option<&Bound<'_, PyDict>>, wheel_profile: &str) -> PyR
     Ok(p)
 }
 
+/// Arc length (m) of every wheelset at t = 0, front to rear over `cars` cars whose front tank
+/// centre is at `station`: read off the train `rail_mbs::vehicle::build_train` builds (on a
+/// straight track from the origin, where s is the global x), so it is that builder's placement.
+#[pyfunction]
+#[pyo3(signature = (cars=1, station=50.0, car=None))]
+pub fn wheelset_stations(
+    py: Python<'_>,
+    cars: usize,
+    station: f64,
+    car: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Vec<f64>> {
+    let params = car_params(car, "s1002")?;
+    let length = station.abs() + 100.0 * cars as f64 + 100.0;
+    let track =
+        Arc::new(Track::straight(length).map_err(|e| crate::to_py(invalid("station", station, &e.to_string())))?);
+    let mut sc = TrainScenario::single(params, track, station, 0.0, 1.0);
+    sc.cars = cars;
+    compute(py, move || {
+        let (mb, bodies, _) = rail_mbs::vehicle::build_train(&sc)?;
+        Ok(bodies.iter().flat_map(|c| c.wheelsets.iter().map(|w| mb.bodies()[w.0].position.x)).collect())
+    })
+}
+
 /// Default tank-car parameters (the overridable scalar fields), the DOF count and the
 /// total mass; `car` overrides fields as in `run_train`.
 #[pyfunction]
@@ -601,6 +624,7 @@ pub fn run_equivalent_train<'py>(
 /// Registers the vehicle functions.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(tank_car_parameters, m)?)?;
+    m.add_function(wrap_pyfunction!(wheelset_stations, m)?)?;
     m.add_function(wrap_pyfunction!(run_train, m)?)?;
     m.add_function(wrap_pyfunction!(run_fluid_train, m)?)?;
     m.add_function(wrap_pyfunction!(design_brake_torque, m)?)?;
