@@ -582,6 +582,28 @@ def test_the_wall_damping_ratio_reaches_the_fluid_run_and_its_results():
     assert np.abs(f1 - f0).max() > 1e-3 * np.abs(f0).max()
 
 
+def test_the_wall_adhesion_reaches_the_runs_of_vehicle_and_slosh_scenes():
+    """``[tank] wall_adhesion`` (default 0, a unilateral wall) goes to run_fluid and slosh.run, reads
+    back from to_dict, is refused out of [0, 50] naming the field, and does not go to the equivalent
+    model (it has no walls)."""
+    base = _set_dotted(FLUID_BASE, "train.t_end", 0.3)
+    assert scene.load_scene(base).fluid_kwargs()["wall_adhesion"] == 0.0
+    sc = scene.load_scene(_set_dotted(base, "tank", {"wall_adhesion": 4.0}))
+    assert sc.fluid.wall_adhesion == 4.0 and sc.fluid_kwargs()["wall_adhesion"] == 4.0
+    assert "wall_adhesion" not in sc.equivalent_kwargs("longitudinal")
+    assert scene.load_scene(sc.to_dict()).fluid == sc.fluid
+    with pytest.raises(ValueError, match=r"invalid `tank.wall_adhesion` = 51"):
+        scene.load_scene(_set_dotted(base, "tank", {"wall_adhesion": 51.0}))
+    sl = scene.load_scene(_set_dotted(SLOSH_BASE, "tank.wall_adhesion", 4.0))
+    assert sl.run_args()[1]["wall_adhesion"] == 4.0
+    assert "wall_adhesion" not in scene.load_scene(SLOSH_BASE).run_args()[1]
+    with pytest.raises(ValueError, match=r"invalid `tank.wall_adhesion` = -1"):
+        scene.load_scene(_set_dotted(SLOSH_BASE, "tank.wall_adhesion", -1.0))
+    # every shipped ECP scene opts in (docs/validation.md, "Wall peeling")
+    for path in sorted((ROOT / "examples" / "scenes").glob("crude_ecp_braking_*.toml")):
+        assert scene.load_scene(path).fluid.wall_adhesion == 4.0, path.name
+
+
 def test_the_scene_reference_is_the_schema_table():
     """docs/scenes.md is written from railslosh.scene.schema.SCHEMA (``python -m railslosh.scene``),
     and every key any scene accepts has its row."""

@@ -177,6 +177,7 @@ def run_slosh(
     stepper: str = "implicit",
     wall_damping_ratio: float = ...,
     snapshot_every: float = 0.0,
+    wall_adhesion: float = 0.0,
 ) -> dict[str, Any]: ...
 def run_validation(name: str, quick: bool = False) -> list[dict[str, Any]]: ...
 def work_precision_cases() -> list[str]: ...
@@ -379,6 +380,7 @@ def run_fluid_train(
     progress: _Progress | None = None,
     stream: str | None = None,
     wall_damping_ratio: float = ...,
+    wall_adhesion: float = 0.0,
 ) -> dict[str, Any]: ...
 def run_equivalent_train(
     track: list[list[float]],

@@ -119,6 +119,7 @@ the mesh builder's own upper bound); beyond, those elements degenerate: a sliver
 PARAMETERS: dict[str, Limit] = {
     "fill": FILL,
     "wall_damping_ratio": Limit(0.0, 10.0, noun="a damping ratio"),
+    "wall_adhesion": Limit(0.0, 50.0, noun="a suction in units of the hydrostatic pressure rho g H"),
 }
 """The limits checked alike by scenes and by the API functions that take these parameters."""
 

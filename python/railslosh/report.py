@@ -259,6 +259,8 @@ def _solver(ds: Any) -> list[tuple[str, str]]:
         rows.append(("static wheel load Q₀ (kN)", num(float(a["static_wheel_load"]) / 1e3, 4)))
     if "wall_damping_ratio" in a:
         rows.append(("wall damping ratio", num(a["wall_damping_ratio"], 3, strip=True)))
+    if "wall_adhesion" in a:
+        rows.append(("wall adhesion (× ρ g H)", num(a["wall_adhesion"], 3, strip=True)))
     for k, why, text in (
         ("fluid_model", "fluid_model_reason", "liquid model"),
         ("stepper", "stepper_reason", "stepper"),

@@ -120,7 +120,7 @@ VARIABLES: dict[str, tuple[tuple[str, ...], str, str, str, dict[str, str]]] = {
     ),
 }
 
-_SCALARS = ("static_wheel_load", "dof", "fluid_mass", "elements", "wall_damping_ratio")
+_SCALARS = ("static_wheel_load", "dof", "fluid_mass", "elements", "wall_damping_ratio", "wall_adhesion")
 _CHOICE = ("fluid_model", "fluid_model_reason", "load_filter", "stepper", "stepper_reason")
 """The fluid model of a vehicle scene and why (:mod:`railslosh.fluid_model`), and how its loads were
 recorded (``load_filter``), and the stepper of a slosh run and why (``stepper``, ``stepper_reason``),

@@ -157,6 +157,7 @@ def run(
     stepper: str = "implicit",
     wall_damping_ratio: float = _core.WALL_DAMPING_RATIO,
     snapshot_every: float = 0.0,
+    wall_adhesion: float = 0.0,
 ) -> dict:
     """Integrate the fluid in the moving tank up to `t_end` with steps of at most `h`.
 
@@ -176,8 +177,12 @@ def run(
     edge (``math.inf`` disables either). ``wall_damping_ratio`` (0 to 10, default
     ``_core.WALL_DAMPING_RATIO`` = 0.1) is the damping ratio of the liquid column on the penalty
     wall spring; 1 (critical) removes most of the wall ringing from the loads after an impact
-    (docs/validation.md, "Wall damping"). ``contact_stiffness_factor`` scales the wall-contact
-    penalty stiffness (damping ratio kept).
+    (docs/validation.md, "Wall damping"). ``wall_adhesion`` (0 to 50, default 0: a unilateral
+    wall) is the suction an adhesive wall holds on the wetted liquid (the mesh's wall faces, not
+    its free surface), in units of the hydrostatic pressure at the bottom ρ g H: it keeps the
+    penalty liquid's transient tension from peeling the wetted faces off the wall and slapping them
+    back (docs/validation.md, "Wall peeling"). ``contact_stiffness_factor`` scales the
+    wall-contact penalty stiffness (damping ratio kept).
 
     Run-time invariants (``rail_mbs::invariants``), also on every accepted step: ``"containment"``
     when a fluid node, contact point or the centre of mass lies beyond a wall by more than the same
@@ -216,6 +221,7 @@ def run(
     ParaView.
     """
     wall_damping_ratio = limits.check("wall_damping_ratio", wall_damping_ratio)
+    wall_adhesion = limits.check("wall_adhesion", wall_adhesion)
     motion = motion or Motion()
     unknown = set(motion.acceleration) - set(AXES)
     if unknown:
@@ -249,8 +255,10 @@ def run(
             stepper=stepper,
             wall_damping_ratio=wall_damping_ratio,
             snapshot_every=snapshot_every,
+            wall_adhesion=wall_adhesion,
         )
     res["wall_damping_ratio"] = wall_damping_ratio
+    res["wall_adhesion"] = wall_adhesion
     if res["error"] is not None:
         raise SimulationError(f"slosh run stopped at t = {res['t'][-1]:.4f} s: {res['error']}", res)
     return res

@@ -240,6 +240,7 @@ def run_fluid(
     progress: ProgressArg = None,
     stream: str | os.PathLike[str] | None = None,
     wall_damping_ratio: float = WALL_DAMPING_RATIO,
+    wall_adhesion: float = 0.0,
 ) -> dict[str, Any]:
     """Run tank cars whose tanks carry an ANCF fluid, solved monolithically with the cars.
 
@@ -254,11 +255,15 @@ def run_fluid(
     ``progress``, ``stream`` and ``irregularity`` work as in :func:`run`. ``wall_damping_ratio`` (0 to
     10, default :data:`WALL_DAMPING_RATIO`) is the damping ratio of the liquid column on the penalty
     wall spring: 1 (critical) removes most of the 20-30 Hz wall ringing from the loads after a wave
-    hits a head, at about 1.35x the run time (docs/validation.md, "Wall damping"). ``fill`` is the
+    hits a head, at about 1.35x the run time (docs/validation.md, "Wall damping"). ``wall_adhesion``
+    (0 to 50, default 0: a unilateral wall) is the suction the tank wall holds on the wetted liquid,
+    in units of the hydrostatic pressure at the bottom ρ g H (docs/validation.md, "Wall peeling";
+    :func:`railslosh.slosh.run`). ``fill`` is the
     liquid volume fraction, :data:`railslosh.limits.FILL` (0.03 to 0.97, as in scenes).
     """
     fill = limits.check("fill", fill)
     wall_damping_ratio = limits.check("wall_damping_ratio", wall_damping_ratio)
+    wall_adhesion = limits.check("wall_adhesion", wall_adhesion)
     drive_speed, times, torques = _drive_and_brake(drive, speed, brake)
     samples, irr = _irregularity(irregularity, cars, station, car)
     with progress_callback(progress, "vehicle run") as on_progress:
@@ -289,10 +294,12 @@ def run_fluid(
                 progress=on_progress,
                 stream=None if stream is None else os.fspath(stream),
                 wall_damping_ratio=wall_damping_ratio,
+                wall_adhesion=wall_adhesion,
             )
         )
     res["load_filter"] = load_filter
     res["wall_damping_ratio"] = wall_damping_ratio
+    res["wall_adhesion"] = wall_adhesion
     if irr is not None:
         res["irregularity"] = irr
     return _raise_on_error(res, "fluid vehicle run")

@@ -7,6 +7,10 @@
 //!
 //! f_n = k_p ψ + c_p |ψ| ψ̇ (≥ 0), ψ̇ = ∇ψ·v, **F_n = −w f_n ∇ψ**,
 //!
+//! or, on an adhesive wall ([`WallContactLaw::tension_capacity`] p_a > 0), at the wetted
+//! points (those of the mesh's wall faces, not of its free surface) also a suction once the
+//! liquid pulls away: f_n = k_p ψ down to −p_a at ψ = −p_a/k_p, back to zero at
+//! ψ = −2 p_a/k_p, f_n ≥ −p_a throughout ([`normal_force`], "Adhesive walls" below);
 //! plus a tangential traction from [`WallFriction`]: none, regularized Coulomb
 //! F_t = −w μ f_n v_t/√(|v_t|² + v_ε²) (the seed's f_t = μ f_n), or no-slip as a tangential
 //! viscous penalty F_t = −w c_t χ(ψ) v_t. Here w is the reference area the point represents,
@@ -17,6 +21,22 @@
 //! Positions and velocities are mapped into the tank frame with the tank kinematics
 //! (R, A, Ṙ, ω): p = Aᵀ(r − R), v = Aᵀ(ṙ − Ṙ − ω × (r − R)). In a tank-frame formulation
 //! pass [`TankKinematics::identity`].
+//!
+//! # Adhesive walls
+//!
+//! A liquid below its free surface cannot leave an impermeable wall without cavitating or
+//! letting air in; potential-flow theory keeps it on the wall (u·n = 0). The penalty liquid,
+//! with its artificial sound speed √(k_IC/ρ) (36 m/s in seed 003's tank), carries transient
+//! tension, and on a unilateral wall that tension peels the wetted faces off the wall for a
+//! millisecond or two; they then slap back. Measured on seed 003's tank under the 0.3 g pulse
+//! (docs/validation.md, "Wall peeling"): points on the wall face at 45–85 % of the depth
+//! leave the wall and return within 0.25 ms with up to 5.5 N each, 30–40 N on the whole load
+//! of the 2×4×2 mesh; the spikes carry the raw peak and add zero crossings. An adhesive wall
+//! holds the wetted points with a suction of at most p_a (the cohesive law above: elastic
+//! down to −p_a, softening to zero over the next p_a/k_p), so a wetted point leaves the wall
+//! only when the liquid pulls with more than p_a, as where air reaches it from the free
+//! surface in violent sloshing. The law is conservative (its potential is in
+//! [`WallContact::stored_energy`]); the damping c_p |ψ| ψ̇ acts only where ψ > 0.
 //!
 //! # Culling (which points are checked)
 //!
@@ -59,7 +79,7 @@ use crate::body::{FluidBody, gather_compact};
 use crate::constitutive::{M3, smoothstep};
 use crate::element::scaled;
 use crate::error::{Result, check_non_negative, check_positive, invalid};
-use crate::mesh::Face;
+use crate::mesh::{BoundaryKind, Face};
 use crate::quadrature::{gauss_legendre, gauss_lobatto};
 use crate::shape::{N_SHAPE, normalized_shape};
 use crate::tank::{TankGeometry, WallHit};
@@ -109,6 +129,53 @@ pub struct WallContactLaw {
     pub points_per_edge: usize,
     /// Where the points sit on a face (default [`ContactPointRule::Gauss`]).
     pub point_rule: ContactPointRule,
+    /// p_a, the largest suction (Pa) an adhesive wall holds on the wetted points (module
+    /// docs, "Adhesive walls"); 0 (the default): a unilateral wall.
+    pub tension_capacity: f64,
+}
+
+/// The normal wall traction f_n (Pa; > 0 pushes the liquid back, < 0 holds it on an
+/// adhesive wall) at wall gap ψ (m, > 0 beyond the wall) and gap rate ψ̇ (m/s), for
+/// stiffness k, damping c and tension capacity p_a (0 on a unilateral wall and at points
+/// that are not wetted), with its partial derivatives: `(f_n, ∂f_n/∂ψ, ∂f_n/∂ψ̇)`. `None`:
+/// no traction.
+///
+/// - ψ > 0: f_n = ψ (k + c ψ̇), at least −p_a (the clamp carries no derivative);
+/// - −p_a/k ≤ ψ ≤ 0: f_n = k ψ (suction);
+/// - −2 p_a/k < ψ < −p_a/k: f_n = −k (ψ + 2 p_a/k) (softening to zero).
+pub fn normal_force(k: f64, c: f64, tension_capacity: f64, psi: f64, psid: f64) -> Option<(f64, f64, f64)> {
+    if psi > 0.0 {
+        let f = psi * (k + c * psid);
+        return if f > -tension_capacity {
+            Some((f, k + c * psid, c * psi))
+        } else if tension_capacity > 0.0 {
+            Some((-tension_capacity, 0.0, 0.0))
+        } else {
+            None
+        };
+    }
+    let s = tension_capacity / k;
+    if psi >= -s {
+        (tension_capacity > 0.0).then_some((k * psi, k, 0.0))
+    } else if psi > -2.0 * s {
+        Some((-k * (psi + 2.0 * s), -k, 0.0))
+    } else {
+        None
+    }
+}
+
+/// The potential of the elastic part of [`normal_force`] per unit area (J/m²), zero for a
+/// point out of reach (ψ ≤ −2 p_a/k): ½ k ψ² − k s² for ψ ≥ −s (s = p_a/k; −k s² is the
+/// binding energy of a wetted point at the wall), −½ k (ψ + 2s)² beyond.
+pub fn normal_potential(k: f64, tension_capacity: f64, psi: f64) -> f64 {
+    let s = tension_capacity / k;
+    if psi >= -s {
+        0.5 * k * psi * psi - k * s * s
+    } else if psi > -2.0 * s {
+        -0.5 * k * (psi + 2.0 * s) * (psi + 2.0 * s)
+    } else {
+        0.0
+    }
 }
 
 /// Default damping ratio ζ_w of the liquid column on the penalty wall spring
@@ -136,6 +203,7 @@ impl WallContactLaw {
             friction: WallFriction::Frictionless,
             points_per_edge: 3,
             point_rule: ContactPointRule::Gauss,
+            tension_capacity: 0.0,
         };
         law.damping = law.damping_for_ratio(WALL_DAMPING_RATIO, density, gravity, depth);
         law
@@ -158,10 +226,28 @@ impl WallContactLaw {
         Ok(self)
     }
 
+    /// This law with an adhesive wall holding the wetted points with up to `ratio` times the
+    /// hydrostatic pressure at the bottom of a liquid of `density` and `depth` under `gravity`:
+    /// p_a = ratio ρ g H (finite, `ratio` in [0, 50]; 0: a unilateral wall).
+    pub fn with_adhesion(mut self, ratio: f64, density: f64, gravity: f64, depth: f64) -> Result<Self> {
+        if !(ratio.is_finite() && (0.0..=50.0).contains(&ratio)) {
+            return Err(invalid("wall_adhesion", ratio, "a number in [0, 50]"));
+        }
+        self.tension_capacity = ratio * density * gravity * depth;
+        Ok(self)
+    }
+
+    /// How far inside the tank (m) an adhesive wall still acts on a wetted point,
+    /// 2 p_a/k_p ([`normal_force`]); 0 for a unilateral wall.
+    pub fn reach(&self) -> f64 {
+        2.0 * self.tension_capacity / self.stiffness
+    }
+
     /// Validate; errors name the field.
     pub fn validate(&self) -> Result<()> {
         check_positive("contact.stiffness", self.stiffness)?;
         check_non_negative("contact.damping", self.damping)?;
+        check_non_negative("contact.tension_capacity", self.tension_capacity)?;
         if !(1..=6).contains(&self.points_per_edge) {
             return Err(invalid("contact.points_per_edge", self.points_per_edge, "an integer in [1, 6]"));
         }
@@ -218,6 +304,9 @@ pub struct ContactPoint {
     pub weight: f64,
     /// Side of each bulkhead on which the point's liquid lies.
     pub sides: Vec<i8>,
+    /// On a wall face of the mesh (wetted; an adhesive wall holds it), not on the free
+    /// surface.
+    pub wetted: bool,
 }
 
 /// Resultant contact load on the tank and diagnostics.
@@ -373,6 +462,7 @@ impl WallContact {
         let ppe = law.points_per_edge;
         for bf in &body.mesh.boundary {
             let el = bf.element;
+            let wetted = bf.kind == BoundaryKind::Wall;
             let r = &body.elements[el];
             let ehat = scaled(&gather_compact(&body.mesh.nodes, &body.mesh.elements[el]), &r.scale);
             let (fixed, val, (d1, d2)) = match bf.face {
@@ -403,7 +493,7 @@ impl WallContact {
                     }
                     let weight = ws * wt * t1.cross(&t2).norm();
                     let sides = geometry.sides([x[0], x[1], x[2]]);
-                    points.push(ContactPoint { element: el, shape, weight, sides });
+                    points.push(ContactPoint { element: el, shape, weight, sides, wetted });
                 }
             }
             let start = points.len() - ppe * ppe;
@@ -443,7 +533,7 @@ impl WallContact {
             let p = at * (r - rt);
             let p = [p[0], p[1], p[2]];
             let mut depth = if p.iter().all(|x| x.is_finite()) { 0.0 } else { f64::INFINITY };
-            self.geometry.for_each_hit_with(p, sides, false, |h| depth = f64::max(depth, h.psi));
+            self.geometry.for_each_hit_with(p, sides, false, 0.0, |h| depth = f64::max(depth, h.psi));
             if depth > 0.0 && worst.is_none_or(|w| depth > w.depth) {
                 worst = Some(Breach { site, position: p, depth });
             }
@@ -461,18 +551,31 @@ impl WallContact {
     }
 
     /// Energy stored in the contact springs, Σ w ½ k_p ψ² over every contact point and
-    /// every wall it penetrates (J): the potential of the elastic part of the contact force.
+    /// every wall it penetrates (J): the potential of the elastic part of the contact force
+    /// (on an adhesive wall, [`normal_potential`] at the wetted points within reach).
     pub fn stored_energy(&self, body: &FluidBody, kin: &TankKinematics, e: &[f64]) -> f64 {
         let at = kin.rotation.transpose();
         let rt = Vector3::from(kin.position);
+        let k_p = self.law.stiffness;
         let mut u = 0.0;
         for (k, pt) in self.points.iter().enumerate() {
             let p = at * (self.point_position(body, k, e) - rt);
-            self.geometry.for_each_hit_with([p[0], p[1], p[2]], &pt.sides, false, |h| {
-                u += 0.5 * pt.weight * self.law.stiffness * h.psi * h.psi;
+            let (capacity, reach) = self.adhesion(pt);
+            self.geometry.for_each_hit_with([p[0], p[1], p[2]], &pt.sides, false, reach, |h| {
+                u += if capacity > 0.0 {
+                    pt.weight * normal_potential(k_p, capacity, h.psi)
+                } else {
+                    0.5 * pt.weight * k_p * h.psi * h.psi
+                };
             });
         }
         u
+    }
+
+    /// The tension capacity and reach of the wall at point `pt`: the law's for a wetted
+    /// point, none for a free-surface point.
+    fn adhesion(&self, pt: &ContactPoint) -> (f64, f64) {
+        if pt.wetted { (self.law.tension_capacity, self.law.reach()) } else { (0.0, 0.0) }
     }
 
     /// Position of contact point `k` (global).
@@ -585,7 +688,8 @@ impl WallContact {
                 let p = at * d;
                 let mut acc = PointAcc { hits: 0, f: Vector3::zeros(), jp: M3::zeros(), jv: M3::zeros() };
                 let mut v: Option<Vector3<f64>> = None;
-                self.geometry.for_each_hit_with([p[0], p[1], p[2]], &pt.sides, want_jac, |h| {
+                let (capacity, reach) = self.adhesion(pt);
+                self.geometry.for_each_hit_with([p[0], p[1], p[2]], &pt.sides, want_jac, reach, |h| {
                     // the velocity only where some wall is hit
                     let v = *v.get_or_insert_with(|| {
                         let mut rd = Vector3::zeros();
@@ -594,7 +698,7 @@ impl WallContact {
                         }
                         at * (rd - vt0 - w.cross(&d))
                     });
-                    self.add_hit(&mut acc, &h, &v, pt.weight, want_jac);
+                    self.add_hit(&mut acc, &h, &v, pt.weight, capacity, want_jac);
                     load.max_penetration = load.max_penetration.max(h.psi);
                 });
                 if acc.hits == 0 {
@@ -660,6 +764,9 @@ impl WallContact {
             spread = spread.max(u[a].norm_squared());
         }
         let sides = &self.points[face.start].sides;
+        // (an adhesive wall acts on wetted points within its reach inside the tank; the
+        // clearance is a distance, ψ the first-order distance beyond the wall: twice the reach)
+        let reach = 2.0 * self.adhesion(&self.points[face.start]).1;
         // Cheap gate (a heuristic: it only decides whether to try the bound): a face whose
         // node centroid is closer to a wall than a fraction of the face's size is hardly
         // ever culled (faces on the walls), and trying costs more than it saves.
@@ -682,7 +789,7 @@ impl WallContact {
             }
             let extent = lo.iter().chain(&hi).fold(0.0f64, |m, v| m.max(v.abs()));
             let margin = 1e-9 * (base_margin + extent);
-            self.geometry.box_clearance(lo, hi, sides) > margin
+            self.geometry.box_clearance(lo, hi, sides) > margin + reach
         };
         if clear(&face.cells[0]) {
             return face.cells[0].mask;
@@ -692,27 +799,25 @@ impl WallContact {
 
     /// Adds one wall hit to a point's force (and Jacobians if `jac`): the operations of
     /// [`Self::point_force`] for that hit, in the same order.
-    fn add_hit(&self, acc: &mut PointAcc, h: &WallHit, v: &Vector3<f64>, w: f64, jac: bool) {
+    fn add_hit(&self, acc: &mut PointAcc, h: &WallHit, v: &Vector3<f64>, w: f64, capacity: f64, jac: bool) {
         let (k, c) = (self.law.stiffness, self.law.damping);
         acc.hits += 1;
         let g = Vector3::from(h.grad);
         let hm = h.hess;
         let psi = h.psi;
         let psid = g.dot(v);
-        let fnorm = psi * (k + c * psid);
         // (without `jac`, hm is zero and only the force is used)
         let hv = if jac { hm * v } else { Vector3::zeros() };
-        let (fnorm, dfn_dp, dfn_dv) = if fnorm > 0.0 {
-            (fnorm, (k + c * psid) * g + (c * psi) * hv, (c * psi) * g)
-        } else {
-            (0.0, Vector3::zeros(), Vector3::zeros())
+        let (fnorm, dfn_dp, dfn_dv) = match normal_force(k, c, capacity, psi, psid) {
+            Some((f, d_psi, d_psid)) => (f, d_psi * g + d_psid * hv, d_psid * g),
+            None => (0.0, Vector3::zeros(), Vector3::zeros()),
         };
         acc.f -= w * fnorm * g;
         if jac {
             acc.jp -= w * (g * dfn_dp.transpose() + fnorm * hm);
             acc.jv -= w * g * dfn_dv.transpose();
         }
-        if matches!(self.law.friction, WallFriction::Frictionless) {
+        if matches!(self.law.friction, WallFriction::Frictionless) || fnorm < 0.0 {
             return;
         }
         let q = g.dot(&g);
@@ -768,12 +873,13 @@ impl WallContact {
             let (r, rd) = self.point_state(body, k, e, edot);
             let d = r - rt;
             let p = at * d;
-            self.geometry.hits([p[0], p[1], p[2]], &pt.sides, &mut hits);
+            let (capacity, reach) = self.adhesion(pt);
+            self.geometry.hits_within([p[0], p[1], p[2]], &pt.sides, reach, &mut hits);
             if hits.is_empty() {
                 continue;
             }
             let v = at * (rd - Vector3::from(kin.velocity) - w.cross(&d));
-            let (fk, jp, jv) = self.point_force(&hits, &v, pt.weight);
+            let (fk, jp, jv) = self.point_force(&hits, &v, pt.weight, capacity);
             let f = a_mat * fk;
             load.active += 1;
             load.max_penetration = hits.iter().fold(load.max_penetration, |m, h| m.max(h.psi));
@@ -798,55 +904,14 @@ impl WallContact {
         load
     }
 
-    /// Tank-frame contact force at one point and its Jacobians ∂F/∂p, ∂F/∂v.
-    fn point_force(&self, hits: &[WallHit], v: &Vector3<f64>, w: f64) -> (Vector3<f64>, M3, M3) {
-        let (k, c) = (self.law.stiffness, self.law.damping);
-        let mut f = Vector3::zeros();
-        let mut jp = M3::zeros();
-        let mut jv = M3::zeros();
+    /// Tank-frame contact force at one point and its Jacobians ∂F/∂p, ∂F/∂v: the sum of
+    /// [`Self::add_hit`] over its walls.
+    fn point_force(&self, hits: &[WallHit], v: &Vector3<f64>, w: f64, capacity: f64) -> (Vector3<f64>, M3, M3) {
+        let mut acc = PointAcc { hits: 0, f: Vector3::zeros(), jp: M3::zeros(), jv: M3::zeros() };
         for h in hits {
-            let g = Vector3::from(h.grad);
-            let hm = h.hess;
-            let psi = h.psi;
-            let psid = g.dot(v);
-            let fnorm = psi * (k + c * psid);
-            let hv = hm * v;
-            let (fnorm, dfn_dp, dfn_dv) = if fnorm > 0.0 {
-                (fnorm, (k + c * psid) * g + (c * psi) * hv, (c * psi) * g)
-            } else {
-                (0.0, Vector3::zeros(), Vector3::zeros())
-            };
-            f -= w * fnorm * g;
-            jp -= w * (g * dfn_dp.transpose() + fnorm * hm);
-            jv -= w * g * dfn_dv.transpose();
-            if matches!(self.law.friction, WallFriction::Frictionless) {
-                continue;
-            }
-            // tangential relative velocity and its derivatives
-            let q = g.dot(&g);
-            let s = psid;
-            let vt = v - (s / q) * g;
-            let dvt_dv = M3::identity() - g * g.transpose() / q;
-            let hg = hm * g;
-            let dvt_dp = -(g * hv.transpose() / q + (s / q) * hm - (2.0 * s / (q * q)) * g * hg.transpose());
-            match self.law.friction {
-                WallFriction::Frictionless => {}
-                WallFriction::Coulomb { coefficient: mu, slip_velocity: eps } => {
-                    let m = (vt.dot(&vt) + eps * eps).sqrt();
-                    let dir = M3::identity() / m - vt * vt.transpose() / (m * m * m);
-                    f -= w * mu * fnorm * vt / m;
-                    jp -= w * mu * (vt / m * dfn_dp.transpose() + fnorm * dir * dvt_dp);
-                    jv -= w * mu * (vt / m * dfn_dv.transpose() + fnorm * dir * dvt_dv);
-                }
-                WallFriction::NoSlip { drag, activation_depth } => {
-                    let (chi, dchi) = smoothstep(psi / activation_depth);
-                    f -= w * drag * chi * vt;
-                    jp -= w * drag * (vt * (dchi / activation_depth) * g.transpose() + chi * dvt_dp);
-                    jv -= w * drag * chi * dvt_dv;
-                }
-            }
+            self.add_hit(&mut acc, h, v, w, capacity, true);
         }
-        (f, jp, jv)
+        (acc.f, acc.jp, acc.jv)
     }
 }
 
@@ -969,21 +1034,29 @@ mod tests {
     }
 
     fn setup(friction: WallFriction) -> (FluidBody, WallContact, TankKinematics, Vec<f64>, Vec<f64>) {
+        // a slightly smaller tank and a bulkhead: many points penetrate
+        setup_in(friction, TankShape::Box { min: [-0.29, -0.195, 0.004], max: [0.29, 0.195, 0.29] }, 0.0)
+    }
+
+    /// The contact of a 2×2×1 box of liquid (0.6 × 0.4 × 0.3 m, its top the free surface)
+    /// in tank `shape` with a bulkhead at x = 0.01 m, in a moving tank frame, with noisy
+    /// coordinates and velocities.
+    fn setup_in(
+        friction: WallFriction,
+        shape: TankShape,
+        tension_capacity: f64,
+    ) -> (FluidBody, WallContact, TankKinematics, Vec<f64>, Vec<f64>) {
         let mesh = box_mesh([-0.3, -0.2, 0.0], [0.6, 0.4, 0.3], [2, 2, 1]).unwrap();
         let fluid = Fluid::new(1000.0, Rheology::Newtonian { viscosity: 1.0 }, 1e5).unwrap();
         let body = FluidBody::new(mesh, fluid, QuadratureOptions::default()).unwrap();
-        // a slightly smaller tank and a bulkhead: many points penetrate
-        let geo = TankGeometry::new(
-            TankShape::Box { min: [-0.29, -0.195, 0.004], max: [0.29, 0.195, 0.29] },
-            vec![Bulkhead { x: 0.01, thickness: 0.01 }],
-        )
-        .unwrap();
+        let geo = TankGeometry::new(shape, vec![Bulkhead { x: 0.01, thickness: 0.01 }]).unwrap();
         let law = WallContactLaw {
             stiffness: 1e6,
             damping: 2e5,
             friction,
             points_per_edge: 2,
             point_rule: ContactPointRule::Gauss,
+            tension_capacity,
         };
         let contact = WallContact::new(&body, geo, law).unwrap();
         let rot = *Rotation3::from_euler_angles(0.1, -0.2, 0.3).matrix();
@@ -1150,5 +1223,123 @@ mod tests {
         let mut nan = e.clone();
         nan[0] = f64::NAN;
         assert_eq!(c.containment(&body, &kin, &nan).map(|b| b.depth), Some(f64::INFINITY));
+    }
+
+    /// An adhesive wall: a tank 1.5 mm larger than the liquid on the −x, −y, −z sides and
+    /// 0.5 mm on the +x, +y sides (the noise of [`setup_in`] is 0–2 mm) and p_a = 3 kPa with
+    /// k_p = 1 MPa/m (s = 3 mm, reach 6 mm): with ±2 mm of noise, wetted points fall on
+    /// every branch of the law.
+    fn adhesive_setup(friction: WallFriction) -> (FluidBody, WallContact, TankKinematics, Vec<f64>, Vec<f64>) {
+        setup_in(friction, TankShape::Box { min: [-0.3015, -0.2015, -0.0015], max: [0.3005, 0.2005, 0.35] }, 3e3)
+    }
+
+    #[test]
+    fn the_normal_law_is_continuous_and_its_potential_is_its_integral() {
+        let (k, c, pa) = (1e6, 2e5, 3e3);
+        let s = pa / k;
+        let f = |psi: f64, psid: f64| normal_force(k, c, pa, psi, psid).map_or(0.0, |x| x.0);
+        for psid in [-0.5, 0.0, 0.3] {
+            // continuous at the branch ends (value and, off the clamp, no jump)
+            for psi in [0.0, -s, -2.0 * s] {
+                assert!((f(psi + 1e-12, psid) - f(psi - 1e-12, psid)).abs() < 1e-5, "ψ = {psi}, ψ̇ = {psid}");
+            }
+        }
+        assert_eq!(f(-s, 0.0), -pa);
+        assert_eq!(f(-2.0 * s - 1e-9, 0.0), 0.0);
+        // the suction never exceeds p_a, however fast the liquid leaves
+        assert_eq!(f(1e-3, -100.0), -pa);
+        // a unilateral wall: the old law, bit for bit
+        for (psi, psid) in [(1e-3, 0.2), (2e-3, -0.01), (-1e-3, 0.0)] {
+            let old = psi * (k + c * psid);
+            let new = normal_force(k, c, 0.0, psi, psid);
+            if old > 0.0 && psi > 0.0 {
+                assert_eq!(new, Some((old, k + c * psid, c * psi)));
+            } else {
+                assert_eq!(new, None);
+            }
+        }
+        // dU/dψ = f_n (damping off), central differences across the branches
+        for i in 0..40 {
+            let psi = -7e-3 + 8e-3 * i as f64 / 39.0 + 1.3e-6;
+            let h = 1e-8;
+            let du = (normal_potential(k, pa, psi + h) - normal_potential(k, pa, psi - h)) / (2.0 * h);
+            let fe = normal_force(k, 0.0, pa, psi, 0.0).map_or(0.0, |x| x.0);
+            assert!((du - fe).abs() < 1e-4 * pa, "ψ = {psi}: dU/dψ {du} vs f {fe}");
+        }
+        let e = WallContactLaw::default_for(1000.0, 9.81, 0.1).with_adhesion(-1.0, 1000.0, 9.81, 0.1).unwrap_err();
+        assert!(e.to_string().contains("wall_adhesion") && e.to_string().contains("[0, 50]"), "{e}");
+    }
+
+    #[test]
+    fn adhesive_contact_jacobians_match_finite_differences_and_energy() {
+        for friction in [WallFriction::Frictionless, WallFriction::Coulomb { coefficient: 0.4, slip_velocity: 0.05 }] {
+            let (body, contact, kin, e, edot) = adhesive_setup(friction);
+            let n = body.n_coords();
+            let mut q = vec![0.0; n];
+            let mut jac = Vec::new();
+            let load = contact.forces(&body, &kin, &e, &edot, &mut q, Some(&mut jac));
+            // points on every branch: penetrating, held by suction, out of reach
+            let at = kin.rotation.transpose();
+            let (mut pushed, mut held) = (0, 0);
+            for (k, pt) in contact.points.iter().enumerate() {
+                let p = at * (contact.point_position(&body, k, &e) - Vector3::from(kin.position));
+                contact.geometry.for_each_hit_with([p[0], p[1], p[2]], &pt.sides, false, contact.law.reach(), |h| {
+                    if h.psi > 0.0 {
+                        pushed += 1
+                    } else if pt.wetted {
+                        held += 1
+                    }
+                });
+            }
+            assert!(pushed > 3 && held > 3 && load.active > 6, "pushed {pushed}, held {held}");
+            // the culled pass equals the full one, bit for bit
+            let mut q_full = vec![0.0; n];
+            let full = contact.forces_full(&body, &kin, &e, &edot, &mut q_full, None);
+            assert_eq!(q, q_full);
+            assert_eq!(load.force, full.force);
+            let mut kr = vec![0.0; n * n];
+            let mut kv = vec![0.0; n * n];
+            dense_jacobians(&contact, &body, &jac, &mut kr, &mut kv);
+            for (which, k) in [(0, &kr), (1, &kv)] {
+                let scale = k.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+                let mut worst = 0.0f64;
+                for d in 0..n {
+                    let h = 1e-7;
+                    let (mut xp, mut xm) =
+                        if which == 0 { (e.clone(), e.clone()) } else { (edot.clone(), edot.clone()) };
+                    xp[d] += h;
+                    xm[d] -= h;
+                    let (mut qp, mut qm) = (vec![0.0; n], vec![0.0; n]);
+                    if which == 0 {
+                        contact.forces(&body, &kin, &xp, &edot, &mut qp, None);
+                        contact.forces(&body, &kin, &xm, &edot, &mut qm, None);
+                    } else {
+                        contact.forces(&body, &kin, &e, &xp, &mut qp, None);
+                        contact.forces(&body, &kin, &e, &xm, &mut qm, None);
+                    }
+                    for r in 0..n {
+                        let fd = (qp[r] - qm[r]) / (2.0 * h);
+                        worst = worst.max((fd - k[r * n + d]).abs());
+                    }
+                }
+                assert!(worst / scale < 1e-6, "{friction:?} {which}: {:.2e}", worst / scale);
+            }
+        }
+        // stored energy: d/ds U(e + s δ) = −(elastic contact force)·δ, damping off
+        let (body, c, kin, e, _) = adhesive_setup(WallFriction::Frictionless);
+        let c0 = WallContact { law: WallContactLaw { damping: 0.0, ..c.law }, ..c.clone() };
+        let mut rng = Rng::new(5);
+        let d: Vec<f64> = (0..e.len()).map(|_| rng.uniform() * 1e-3).collect();
+        let zero = vec![0.0; e.len()];
+        let mut f = vec![0.0; e.len()];
+        c0.forces(&body, &kin, &e, &zero, &mut f, None);
+        let s = 1e-5;
+        let plus: Vec<f64> = e.iter().zip(&d).map(|(x, y)| x + s * y).collect();
+        let minus: Vec<f64> = e.iter().zip(&d).map(|(x, y)| x - s * y).collect();
+        let du = (c0.stored_energy(&body, &kin, &plus) - c0.stored_energy(&body, &kin, &minus)) / (2.0 * s);
+        let fd: f64 = f.iter().zip(&d).map(|(x, y)| x * y).sum();
+        assert!((du + fd).abs() < 1e-6 * fd.abs().max(1e-9), "dU = {du}, -F.d = {}", -fd);
+        // nothing is beyond the walls by the containment check (it ignores the reach)
+        assert!(c.containment(&body, &kin, &e).is_none_or(|b| b.depth < 0.003));
     }
 }

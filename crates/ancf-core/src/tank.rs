@@ -142,19 +142,35 @@ impl TankGeometry {
     /// At most 3 shell walls are active at once (a box corner; cylinders: shell + one
     /// end), plus one per bulkhead whose liquid side the point has left.
     pub fn for_each_hit(&self, p: [f64; 3], side: &[i8], sink: impl FnMut(WallHit)) {
-        self.for_each_hit_with(p, side, true, sink);
+        self.for_each_hit_with(p, side, true, 0.0, sink);
     }
 
-    /// [`Self::for_each_hit`]; with `hessian` false, every `hess` is left zero (the same
-    /// ψ and ∇ψ, bit for bit; for callers that need no Jacobian).
-    pub(crate) fn for_each_hit_with(&self, p: [f64; 3], side: &[i8], hessian: bool, mut sink: impl FnMut(WallHit)) {
+    /// [`Self::hits`] extended to every wall with ψ > −`reach` (`reach` ≥ 0, m): the walls
+    /// within `reach` inside the tank too (wetted points of an adhesive wall,
+    /// [`crate::contact::WallContactLaw::tension_capacity`]). `reach` = 0 is [`Self::hits`].
+    pub fn hits_within(&self, p: [f64; 3], side: &[i8], reach: f64, out: &mut Vec<WallHit>) {
+        out.clear();
+        self.for_each_hit_with(p, side, true, reach, |h| out.push(h));
+    }
+
+    /// [`Self::for_each_hit`] for the walls with ψ > −`reach`; with `hessian` false, every
+    /// `hess` is left zero (the same ψ and ∇ψ, bit for bit; for callers that need no
+    /// Jacobian).
+    pub(crate) fn for_each_hit_with(
+        &self,
+        p: [f64; 3],
+        side: &[i8],
+        hessian: bool,
+        reach: f64,
+        mut sink: impl FnMut(WallHit),
+    ) {
         let [x, y, z] = p;
         match self.shape {
             TankShape::Cylinder { length, radius: r, head_depth: hd } => {
                 let xc = 0.5 * length;
                 if hd == 0.0 || x.abs() <= xc {
                     let rho = (y * y + z * z).sqrt();
-                    if rho - r > 0.0 {
+                    if rho - r > -reach {
                         let n = [0.0, y / rho, z / rho];
                         let mut h = M3::zeros();
                         if hessian {
@@ -168,39 +184,39 @@ impl TankGeometry {
                     }
                 }
                 if hd == 0.0 {
-                    plane(p, [1.0, 0.0, 0.0], xc, &mut sink);
-                    plane(p, [-1.0, 0.0, 0.0], xc, &mut sink);
+                    plane(p, [1.0, 0.0, 0.0], xc, reach, &mut sink);
+                    plane(p, [-1.0, 0.0, 0.0], xc, reach, &mut sink);
                 } else if x.abs() > xc {
                     let dx = x - xc * x.signum();
                     let inv = [1.0 / (hd * hd), 1.0 / (r * r), 1.0 / (r * r)];
                     let q = [dx, y, z];
-                    if let Some(h) = quadric_hit(&q, &inv, hessian) {
+                    if let Some(h) = quadric_hit(&q, &inv, hessian, reach) {
                         sink(h);
                     }
                 }
             }
             TankShape::EllipticCylinder { length, semi_axis_y: a, semi_axis_z: b } => {
                 let inv = [0.0, 1.0 / (a * a), 1.0 / (b * b)];
-                if let Some(h) = quadric_hit(&[0.0, y, z], &inv, hessian) {
+                if let Some(h) = quadric_hit(&[0.0, y, z], &inv, hessian, reach) {
                     sink(h);
                 }
-                plane(p, [1.0, 0.0, 0.0], 0.5 * length, &mut sink);
-                plane(p, [-1.0, 0.0, 0.0], 0.5 * length, &mut sink);
+                plane(p, [1.0, 0.0, 0.0], 0.5 * length, reach, &mut sink);
+                plane(p, [-1.0, 0.0, 0.0], 0.5 * length, reach, &mut sink);
             }
             TankShape::Box { min, max } => {
                 for d in 0..3 {
                     let mut n = [0.0; 3];
                     n[d] = 1.0;
-                    plane(p, n, max[d], &mut sink);
+                    plane(p, n, max[d], reach, &mut sink);
                     n[d] = -1.0;
-                    plane(p, n, -min[d], &mut sink);
+                    plane(p, n, -min[d], reach, &mut sink);
                 }
             }
         }
         for (b, s) in self.bulkheads.iter().zip(side) {
             let s = *s as f64;
             let psi = 0.5 * b.thickness - s * (x - b.x);
-            if psi > 0.0 {
+            if psi > -reach {
                 sink(WallHit { psi, grad: [-s, 0.0, 0.0], hess: M3::zeros() });
             }
         }
@@ -308,9 +324,9 @@ fn self_axial_extent(shape: &TankShape) -> (f64, f64) {
 }
 
 /// A plane wall n·p = d: its hit, if ψ = n·p − d > 0.
-fn plane(p: [f64; 3], n: [f64; 3], d: f64, sink: &mut impl FnMut(WallHit)) {
+fn plane(p: [f64; 3], n: [f64; 3], d: f64, reach: f64, sink: &mut impl FnMut(WallHit)) {
     let psi = n[0] * p[0] + n[1] * p[1] + n[2] * p[2] - d;
-    if psi > 0.0 {
+    if psi > -reach {
         sink(WallHit { psi, grad: n, hess: M3::zeros() });
     }
 }
@@ -327,18 +343,23 @@ fn plane(p: [f64; 3], n: [f64; 3], d: f64, sink: &mut impl FnMut(WallHit)) {
 /// ∇²u = (A − r B) ∇(1/(u w))ᵀ + (D − r D² − B ∇rᵀ)/(u w) with
 /// ∇(1/(u w)) = −∇r/(2 u³ w) − 2 B/(u w²), and
 /// ∇ψ = u ∇g + (g − 1) ∇u, ∇²ψ = u ∇²g + ∇g ∇uᵀ + ∇u ∇gᵀ + (g − 1) ∇²u.
-fn quadric_hit(q: &[f64; 3], inv: &[f64; 3], hessian: bool) -> Option<WallHit> {
+fn quadric_hit(q: &[f64; 3], inv: &[f64; 3], hessian: bool, reach: f64) -> Option<WallHit> {
     let a: [f64; 3] = std::array::from_fn(|i| inv[i] * q[i]);
     let b: [f64; 3] = std::array::from_fn(|i| inv[i] * a[i]);
     let phi: f64 = (0..3).map(|i| q[i] * a[i]).sum();
     let g = phi.sqrt();
-    if g <= 1.0 {
+    // (inside, only points near the wall can be within `reach`: g ≥ 1/2 keeps clear of the
+    // centre, where ∇g vanishes)
+    if g <= 1.0 && (reach <= 0.0 || g < 0.5) {
         return None;
     }
     let w: f64 = a.iter().map(|x| x * x).sum();
     let r = phi / w;
     let u = r.sqrt();
     let psi = (g - 1.0) * u;
+    if psi <= -reach {
+        return None;
+    }
     let c: [f64; 3] = std::array::from_fn(|i| a[i] - r * b[i]); // A − r B
     let grad_g: [f64; 3] = std::array::from_fn(|i| a[i] / g);
     let grad_u: [f64; 3] = std::array::from_fn(|i| c[i] / (u * w));

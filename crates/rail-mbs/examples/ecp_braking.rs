@@ -1,5 +1,5 @@
 //! One braking run of the crude-oil studies with its wall time and Newton statistics:
-//! `cargo run --release -p rail-mbs --example ecp_braking -- [light|medium|heavy|water] [nx ny nz] [t_end] [ecp|conventional] [bulkheads|-] [wall_damping_ratio] [condensed|direct]`
+//! `cargo run --release -p rail-mbs --example ecp_braking -- [light|medium|heavy|water] [nx ny nz] [t_end] [ecp|conventional] [bulkheads|-] [wall_damping_ratio] [condensed|direct] [wall_adhesion]`
 use rail_mbs::defaults::{Oil, SETTLE};
 use rail_mbs::vehicle::BrakeScope;
 use rail_mbs::vehicle::studies::{BrakingCase, run_braking};
@@ -28,6 +28,7 @@ fn main() {
         t_end,
         rear_brake_factor: 1.0,
         wall_damping_ratio,
+        wall_adhesion: a.get(9).map_or(0.0, |s| s.parse().unwrap()),
         linear_solver,
     };
     let r = run_braking(&case).expect("run");

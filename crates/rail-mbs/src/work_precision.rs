@@ -285,6 +285,7 @@ fn ecp_braking(
             t_end,
             rear_brake_factor,
             wall_damping_ratio: ancf_core::contact::WALL_DAMPING_RATIO,
+            wall_adhesion: 0.0,
             linear_solver: crate::integrator::LinearSolverKind::Condensed,
         };
         let tic = Instant::now();

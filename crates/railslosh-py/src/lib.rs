@@ -500,7 +500,7 @@ impl PyFluidBody {
                     progress=None, volume_tolerance=0.01, penetration_limit=0.5, contact_stiffness_factor=1.0,
                     stream=None, checkpoint=None, checkpoint_every=100, resume_from=None,
                     contact_points_per_edge=3, contact_point_rule="gauss", stepper="implicit",
-                    wall_damping_ratio=ancf_core::contact::WALL_DAMPING_RATIO, snapshot_every=0.0))]
+                    wall_damping_ratio=ancf_core::contact::WALL_DAMPING_RATIO, snapshot_every=0.0, wall_adhesion=0.0))]
 #[allow(clippy::too_many_arguments)]
 fn run_slosh<'py>(
     py: Python<'py>,
@@ -531,6 +531,7 @@ fn run_slosh<'py>(
     stepper: &str,
     wall_damping_ratio: f64,
     snapshot_every: f64,
+    wall_adhesion: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
     use ancf_core::contact::ContactPointRule;
     use ancf_core::tank::{Bulkhead, TankShape};
@@ -580,6 +581,7 @@ fn run_slosh<'py>(
     scenario.contact_point_rule = point_rule;
     scenario.contact_stiffness_factor = contact_stiffness_factor;
     scenario.wall_damping_ratio = wall_damping_ratio;
+    scenario.wall_adhesion = wall_adhesion;
     // Failure guards (issue 8): relative volume error and wall penetration per smallest element edge.
     scenario.volume_tolerance = volume_tolerance;
     scenario.penetration_limit = penetration_limit;

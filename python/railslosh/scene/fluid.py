@@ -32,6 +32,9 @@ class FluidSpec:
     wall_damping_ratio: float = WALL_DAMPING_RATIO
     """``[tank] wall_damping_ratio``: damping ratio of the liquid column on the penalty wall (0 to 10;
     1 removes most wall ringing from the loads: :func:`railslosh.vehicle.run_fluid`)."""
+    wall_adhesion: float = 0.0
+    """``[tank] wall_adhesion``: suction the wall holds on the wetted liquid, in units of ρ g H (0 to 50;
+    0 a unilateral wall: :func:`railslosh.slosh.run`)."""
 
     def make_fluid(self, depth: float, element_height: float | None = None, shear_stabilization: bool = False) -> Any:
         """The :class:`railslosh.Fluid` for a liquid ``depth`` m deep: penalty ``k = 1000 rho g depth``
@@ -88,6 +91,8 @@ class FluidSpec:
             d["tank"] = {"bulkheads": [list(b) for b in self.bulkheads]}
         if self.wall_damping_ratio != WALL_DAMPING_RATIO:
             d.setdefault("tank", {})["wall_damping_ratio"] = self.wall_damping_ratio
+        if self.wall_adhesion != 0.0:
+            d.setdefault("tank", {})["wall_adhesion"] = self.wall_adhesion
         return d
 
 
@@ -128,6 +133,7 @@ def vehicle_fluid(doc: Mapping[str, Any], params: Mapping[str, float]) -> FluidS
         custom=custom,
         slosh_model=slosh_model,
         wall_damping_ratio=tk.get("wall_damping_ratio"),
+        wall_adhesion=tk.get("wall_adhesion"),
     )
     if oil == "custom":
         spec.make_fluid(2.0 * params["tank_radius"] * fill)  # validates the custom fluid now

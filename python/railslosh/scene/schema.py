@@ -143,6 +143,13 @@ _WALL_DAMPING = Field(
     WALL_DAMPING_RATIO,
     PARAMETERS["wall_damping_ratio"],
 )
+_WALL_ADHESION = Field(
+    "number",
+    "suction the wall holds on the wetted liquid, in units of the hydrostatic pressure rho g H at the bottom "
+    "(0: a unilateral wall); keeps the wetted liquid from peeling off the wall and slapping back",
+    0.0,
+    PARAMETERS["wall_adhesion"],
+)
 _BULKHEADS = _value(
     "[[x, thickness], ...] (m, tank frame)",
     "full-height plates, inside the shell, not overlapping, each compartment at least one element long",
@@ -316,7 +323,7 @@ SCHEMA: dict[str, dict[str, dict[str, Field]]] = {
                 "[n_length (1-40), n_width (2-20), n_height (1-10)]", "fluid elements per tank", [6, 4, 2]
             ),
         },
-        "tank": {"bulkheads": _BULKHEADS, "wall_damping_ratio": _WALL_DAMPING},
+        "tank": {"bulkheads": _BULKHEADS, "wall_damping_ratio": _WALL_DAMPING, "wall_adhesion": _WALL_ADHESION},
         "outputs": {
             "netcdf": _flag(True, "write results.nc"),
             "vtu": _flag(True, "write fluid/*.vtu and fluid.pvd (needs snapshot_every)"),
@@ -329,6 +336,7 @@ SCHEMA: dict[str, dict[str, dict[str, Field]]] = {
         "tank": {
             "shape": _choice(TANK_SHAPES, "elliptic", "flat-ended elliptic cylinder, cylinder with heads, or box"),
             "wall_damping_ratio": _WALL_DAMPING,
+            "wall_adhesion": _WALL_ADHESION,
         },
         "tank:elliptic": {
             "length": _num(0.05, 50.0, "m", "a length", mesh.SWRI_LENGTH, "tank length (default: SwRI tank)"),

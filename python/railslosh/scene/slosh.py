@@ -149,6 +149,8 @@ class SloshScene:
             kw["contact_stiffness_factor"] = self.contact_stiffness_factor
         if self.fluid.wall_damping_ratio != WALL_DAMPING_RATIO:
             kw["wall_damping_ratio"] = self.fluid.wall_damping_ratio
+        if self.fluid.wall_adhesion != 0.0:
+            kw["wall_adhesion"] = self.fluid.wall_adhesion
         return (self.mesh(), fluid, self.tank, self.motion()), kw
 
     def to_dict(self) -> dict[str, Any]:
@@ -179,7 +181,15 @@ def slosh_scene_from_dict(data: Mapping[str, Any]) -> SloshScene:
     tk = Section("slosh", "tank", data)
     zeta = tk.get("wall_damping_ratio")
     tank = slosh_tank(tk, n)
-    spec = FluidSpec(oil=oil, fill=fill, counts=n, bulkheads=tank.bulkheads, custom=custom, wall_damping_ratio=zeta)
+    spec = FluidSpec(
+        oil=oil,
+        fill=fill,
+        counts=n,
+        bulkheads=tank.bulkheads,
+        custom=custom,
+        wall_damping_ratio=zeta,
+        wall_adhesion=tk.get("wall_adhesion"),
+    )
     man = maneuver(data, t_end)
     outputs = slosh_outputs(data, step)
     sc = SloshScene(

@@ -43,7 +43,7 @@ def slosh_tank(sec: Section, counts: tuple[int, int, int]) -> TankGeometry:
     shape = sec.get("shape")
     allowed = variant_keys("slosh", "tank", shape)
     for k, v in sec.values.items():
-        if k not in ("shape", "wall_damping_ratio") and k not in allowed:
+        if k not in ("shape", "wall_damping_ratio", "wall_adhesion") and k not in allowed:
             raise invalid(f"tank.{k}", v, f"no `tank.{k}` with shape = {shape!r} (its keys: {', '.join(allowed)})")
     if shape == "elliptic":
         return TankGeometry.elliptic(*(sec.get(k, variant=shape) for k in ("length", "semi_axis_y", "semi_axis_z")))

@@ -162,6 +162,7 @@ class Scene:
             "snapshot_every": self.outputs.snapshot_every,
             "brake_factors": None if self.brake_factors is None else list(self.brake_factors),
             "wall_damping_ratio": f.wall_damping_ratio,
+            "wall_adhesion": f.wall_adhesion,
         }
         return kw
 
@@ -169,7 +170,7 @@ class Scene:
         """Keyword arguments of :func:`railslosh.vehicle.run_equivalent` (after the track): the liquid
         as its equivalent slosh model along ``slosh_axis``."""
         kw = self.fluid_kwargs()
-        for k in ("counts", "snapshot_every", "wall_damping_ratio"):
+        for k in ("counts", "snapshot_every", "wall_damping_ratio", "wall_adhesion"):
             kw.pop(k)
         kw["slosh_axis"] = slosh_axis
         return kw

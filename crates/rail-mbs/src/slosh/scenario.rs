@@ -45,6 +45,10 @@ pub struct SloshScenario {
     /// Damping ratio of the liquid column on the wall spring. Default
     /// [`WALL_DAMPING_RATIO`].
     pub wall_damping_ratio: f64,
+    /// Suction an adhesive wall holds on the wetted liquid, in units of the hydrostatic
+    /// pressure at the bottom ρ g H ([`WallContactLaw::with_adhesion`]). Default 0: a
+    /// unilateral wall.
+    pub wall_adhesion: f64,
     /// Largest relative volume error a step may have. Default 0.01 (`f64::INFINITY`: none).
     pub volume_tolerance: f64,
     /// Largest wall penetration as a fraction of the smallest element edge. Default
@@ -68,6 +72,7 @@ impl SloshScenario {
             contact_point_rule: ContactPointRule::Gauss,
             contact_stiffness_factor: 1.0,
             wall_damping_ratio: WALL_DAMPING_RATIO,
+            wall_adhesion: 0.0,
             volume_tolerance: 0.01,
             penetration_limit: PENETRATION_LIMIT_FACTOR,
         }
@@ -93,12 +98,13 @@ impl SloshScenario {
     }
 
     /// The wall law: the default penalty for this liquid's depth and gravity, with the damping
-    /// ratio, the stiffness factor (damping × factor^1.5, the ratio kept) and the contact points.
+    /// ratio, the adhesion (its suction from the default stiffness), the stiffness factor (damping × factor^1.5, the ratio kept) and the contact points.
     pub fn wall_law(&self) -> Result<WallContactLaw, AncfError> {
         let g = self.gravity.iter().map(|x| x * x).sum::<f64>().sqrt().max(1e-3);
         let (rho, depth) = (self.fluid.density, self.depth());
-        let mut law =
-            WallContactLaw::default_for(rho, g, depth).with_damping_ratio(self.wall_damping_ratio, rho, g, depth)?;
+        let mut law = WallContactLaw::default_for(rho, g, depth)
+            .with_damping_ratio(self.wall_damping_ratio, rho, g, depth)?
+            .with_adhesion(self.wall_adhesion, rho, g, depth)?;
         law.stiffness *= self.contact_stiffness_factor;
         law.damping *= self.contact_stiffness_factor.powf(1.5);
         law.points_per_edge = self.contact_points_per_edge;

@@ -64,6 +64,9 @@ pub struct BrakingCase {
     /// the library default [`ancf_core::contact::WALL_DAMPING_RATIO`], or 1 as the shipped ECP
     /// scenes use).
     pub wall_damping_ratio: f64,
+    /// Suction the tank walls hold on the wetted liquid, × ρ g H ([`FluidCargo::wall_adhesion`];
+    /// 0, or 4 as the shipped ECP scenes use).
+    pub wall_adhesion: f64,
     /// How the coupled Newton matrix is solved ([`FluidCargo::linear_solver`]).
     pub linear_solver: crate::integrator::LinearSolverKind,
 }
@@ -99,6 +102,7 @@ pub fn run_braking_with(case: &BrakingCase, step: f64, rel_tol: f64) -> Result<F
     let p = TankCarParams::standard()?;
     let mut cg = cargo(case.oil, case.counts, case.bulkheads, &p)?;
     cg.wall_damping_ratio = case.wall_damping_ratio;
+    cg.wall_adhesion = case.wall_adhesion;
     cg.linear_solver = case.linear_solver;
     let v0 = 40.0 / 3.6;
     let mut sc = TrainScenario::single(p.clone(), tangent()?, 300.0, v0, case.t_end);
@@ -208,6 +212,7 @@ fn braking(oil: Oil, cars: usize, scope: BrakeScope, bulkheads: bool, quick: boo
         t_end,
         rear_brake_factor: rear,
         wall_damping_ratio: ancf_core::contact::WALL_DAMPING_RATIO,
+        wall_adhesion: 0.0,
         linear_solver: crate::integrator::LinearSolverKind::Condensed,
     }
 }
@@ -510,6 +515,7 @@ fn mesh_convergence(quick: bool) -> Result<Vec<Record>> {
                     t_end,
                     rear_brake_factor: 1.0,
                     wall_damping_ratio: ancf_core::contact::WALL_DAMPING_RATIO,
+                    wall_adhesion: 0.0,
                     linear_solver: crate::integrator::LinearSolverKind::Condensed,
                 })
             }) as Job<'static, FluidTrainRecord>
@@ -565,8 +571,9 @@ fn coupler_statistics(rec: &FluidTrainRecord) -> [f64; 3] {
 /// are taken against the finer run's value; for the ECP steady mean, whose reference is
 /// near zero (identical brakes), against the conventional steady mean (the scale of the
 /// coupler force in this study). Quick: meshes 2×2×2, 3×2×2, 4×2×2, 3 s; full: 4×4×2,
-/// 6×4×2 (the paper's), 8×4×2, the paper's 10.5 s. Walls critically damped
-/// (`wall_damping_ratio` = 1, as the shipped ECP scenes: docs/validation.md "Wall damping").
+/// 6×4×2 (the paper's), 8×4×2, the paper's 10.5 s. Walls critically damped and adhesive
+/// (`wall_damping_ratio` = 1, `wall_adhesion` = 4, as the shipped ECP scenes:
+/// docs/validation.md "Wall damping", "Wall peeling").
 fn coupler_force_convergence(quick: bool) -> Result<Vec<Record>> {
     let c = "coupler-force-convergence";
     let (meshes, t_end): ([[usize; 3]; 3], f64) =
@@ -582,6 +589,7 @@ fn coupler_force_convergence(quick: bool) -> Result<Vec<Record>> {
             t_end,
             rear_brake_factor: 1.0,
             wall_damping_ratio: 1.0,
+            wall_adhesion: 4.0,
             linear_solver: crate::integrator::LinearSolverKind::Condensed,
         };
         for m in meshes {

@@ -39,6 +39,9 @@ pub struct FluidCargo {
     /// ([`ancf_core::contact::WallContactLaw::with_damping_ratio`]); default
     /// [`ancf_core::contact::WALL_DAMPING_RATIO`].
     pub wall_damping_ratio: f64,
+    /// Suction an adhesive wall holds on the wetted liquid, in units of ρ g H
+    /// ([`ancf_core::contact::WallContactLaw::with_adhesion`]); default 0 (unilateral).
+    pub wall_adhesion: f64,
     /// How the coupled Newton matrix is solved ([`FluidVehicle::linear_solver`]); default
     /// [`LinearSolverKind::Condensed`].
     pub linear_solver: LinearSolverKind,
@@ -61,6 +64,7 @@ impl FluidCargo {
             wall_stiffness_factor: 1.0,
             contact_points_per_edge: 4,
             wall_damping_ratio: ancf_core::contact::WALL_DAMPING_RATIO,
+            wall_adhesion: 0.0,
             linear_solver: LinearSolverKind::Condensed,
         }
     }
@@ -194,12 +198,10 @@ pub fn build_fluid_train(
     )?;
     let g = crate::track::GRAVITY;
     let depth = 2.0 * p.tank_radius * cargo.fill;
-    let mut law = WallContactLaw::default_for(cargo.fluid.density, g, depth).with_damping_ratio(
-        cargo.wall_damping_ratio,
-        cargo.fluid.density,
-        g,
-        depth,
-    )?;
+    let rho = cargo.fluid.density;
+    let mut law = WallContactLaw::default_for(rho, g, depth)
+        .with_damping_ratio(cargo.wall_damping_ratio, rho, g, depth)?
+        .with_adhesion(cargo.wall_adhesion, rho, g, depth)?;
     ancf_core::error::check_positive("wall_stiffness_factor", cargo.wall_stiffness_factor)?;
     law.stiffness *= cargo.wall_stiffness_factor;
     law.damping *= cargo.wall_stiffness_factor.powf(1.5);
