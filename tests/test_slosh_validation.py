@@ -19,6 +19,7 @@ from railslosh import validate
         "tank-frame-equivalence",
         "bulkhead-longitudinal",
         "slosh-linear-potential-flow",
+        "slosh-load-convergence",
     ],
 )
 def test_quick_slosh_case_passes(case):

@@ -8,7 +8,8 @@
 //! with KIND `box` (seed 003 rectangular tank), `swri` (SwRI elliptic tank) or `car` (the tank
 //! car half full of light crude; `HEAD=0` for flat ends), NV/NP the viscous/penalty points per
 //! direction, PPE the contact points per face edge and NX NY NZ the element counts.
-//! `SHAPE=1` also prints the nodes that carry the three lowest modes.
+//! `SHAPE=1` also prints the nodes that carry the three lowest modes; `ADH=a` gives the walls an
+//! adhesion of a ρ g H (`WallContactLaw::with_adhesion`).
 use ancf_core::FluidBody;
 use ancf_core::constants::GRAVITY as G;
 use ancf_core::constitutive::Rheology;
@@ -80,7 +81,10 @@ fn main() {
     let working = fluid.rheology;
     fluid.rheology = Rheology::Newtonian { viscosity: 1e4 };
     let body = FluidBody::new(mesh, fluid, QuadratureOptions { viscous: nv, penalty: np, mass: 4 }).unwrap();
-    let law = WallContactLaw { points_per_edge: ppe, ..WallContactLaw::default_for(rho, G, depth) };
+    let adhesion: f64 = std::env::var("ADH").ok().map_or(0.0, |v| v.parse().unwrap());
+    let law = WallContactLaw { points_per_edge: ppe, ..WallContactLaw::default_for(rho, G, depth) }
+        .with_adhesion(adhesion, rho, G, depth)
+        .unwrap();
     let contact = WallContact::new(&body, geo, law).unwrap();
     let sys =
         SloshSystem::new(body, contact, PrescribedMotion::at_rest([0.0; 3]), [0.0, 0.0, -G], SloshFrame::Inertial)
@@ -92,7 +96,8 @@ fn main() {
     let run_v = run.stepper.v().to_vec();
     let mut sys = run.stepper.into_system();
     let rgh = rho * G * depth;
-    let g_default = sys.body.fluid.shear_stabilization;
+    // the recommended value for this mesh's element height (its fluid carries none)
+    let g_default = rail_mbs::defaults::default_shear_stabilization(rho, depth / c[2] as f64);
     {
         use rail_mbs::integrator::MechanicalSystem;
         let n = sys.n_coords();

@@ -731,6 +731,12 @@ struct PulseLoad {
     steps: usize,
 }
 
+/// Wall damping ratio of `slosh-load-convergence` (critical, as the shipped ECP and lane-change
+/// scenes).
+const LOAD_CONVERGENCE_WALL_DAMPING: f64 = 1.0;
+/// Wall adhesion of `slosh-load-convergence` (suction, × ρ g H): docs/validation.md, "Wall peeling".
+const LOAD_CONVERGENCE_WALL_ADHESION: f64 = 4.0;
+
 /// One run of `slosh-load-convergence`: 0.3 g lateral pulse on `counts`, steps ≤ `h`,
 /// figures of F_y over [t_a, t_b] (the run ends at t_b).
 fn pulse_load(counts: [usize; 3], h: f64, t_a: f64, t_b: f64) -> Result<PulseLoad> {
@@ -738,8 +744,9 @@ fn pulse_load(counts: [usize; 3], h: f64, t_a: f64, t_b: f64) -> Result<PulseLoa
     let mut motion = PrescribedMotion::at_rest([0.0; 3]);
     motion.translation[1] = PiecewiseAcceleration::pulse(0.3 * G, 0.1, 0.6, 0.02)?;
     let (mesh, fluid, geo) = rect_setup(counts)?;
-    let mut law = WallContactLaw::default_for(fluid.density, G, d);
-    law.damping *= 30.0;
+    let mut law = WallContactLaw::default_for(fluid.density, G, d)
+        .with_damping_ratio(LOAD_CONVERGENCE_WALL_DAMPING, fluid.density, G, d)?
+        .with_adhesion(LOAD_CONVERGENCE_WALL_ADHESION, fluid.density, G, d)?;
     law.points_per_edge = 4;
     let quad = QuadratureOptions { penalty: 4, ..QuadratureOptions::default() };
     let (rec, _) = run_with(mesh, fluid, geo, law, quad, motion, SloshFrame::Inertial, t_b, h)?;
@@ -821,17 +828,18 @@ fn pulse_load(counts: [usize; 3], h: f64, t_a: f64, t_b: f64) -> Result<PulseLoa
 ///   a few ms of a true crossing (load slope ≈ 350 N/s there), hence the sporadic failures.
 fn slosh_load_convergence(quick: bool) -> Result<Vec<Record>> {
     let c = "slosh-load-convergence";
-    let (meshes, h, h_fine, t_b): ([[usize; 3]; 3], f64, f64, f64) = if quick {
-        ([[2, 2, 2], [2, 3, 2], [2, 4, 2]], 0.004, 0.001, 2.2)
-    } else {
-        ([[2, 4, 2], [2, 6, 3], [2, 8, 4]], 0.004, 0.001, 4.0)
-    };
+    // the quick form: the same meshes and steps over a shorter window (the peak after the
+    // pulse comes at 1.13-1.16 s); 2x4x2 is outside the asymptotic range (peak 40.3 N against
+    // 44.5 N on 2x6x3), so coarser meshes cannot stand in
+    let meshes: [[usize; 3]; 3] = [[2, 4, 2], [2, 6, 3], [2, 8, 4]];
+    let (h, h_fine, t_b) = (0.004, 0.001, if quick { 2.2 } else { 4.0 });
     let t_a = 0.7;
     let runs: Vec<PulseLoad> = meshes.iter().map(|&m| pulse_load(m, h, t_a, t_b)).collect::<Result<_>>()?;
     let fine_step = pulse_load(meshes[1], h_fine, t_a, t_b)?;
     let tag = format!(
         "0.3 g lateral pulse 0.1-0.6 s (20 ms ramps), window {t_a}-{t_b} s, 4^3 penalty points, 4x4 contact \
-         points, contact damping x30"
+         points, wall damping ratio {LOAD_CONVERGENCE_WALL_DAMPING}, wall adhesion {LOAD_CONVERGENCE_WALL_ADHESION} \
+         rho g H"
     );
     let fig = |r: &PulseLoad| {
         format!(
@@ -839,13 +847,13 @@ fn slosh_load_convergence(quick: bool) -> Result<Vec<Record>> {
             r.peak, r.peak_smoothed, r.f_raw, r.f_smoothed, r.f_spectral, r.steps
         )
     };
-    let per_mesh: Vec<String> =
-        meshes.iter().zip(&runs).map(|(m, r)| format!("{}x{}x{}: {}", m[0], m[1], m[2], fig(r))).collect();
+    let name = |m: &[usize; 3]| format!("{}x{}x{}", m[0], m[1], m[2]);
+    let per_mesh: Vec<String> = meshes.iter().zip(&runs).map(|(m, r)| format!("{}: {}", name(m), fig(r))).collect();
     let per_mesh = per_mesh.join("; ");
     let (mid, fin) = (&runs[1], &runs[2]);
-    let [m1, m2] = [meshes[1], meshes[2]].map(|m| format!("{}x{}x{}", m[0], m[1], m[2]));
+    let [m1, m2] = [meshes[1], meshes[2]].map(|m| name(&m));
     let rel = |a: f64, b: f64| (a - b).abs() / b.abs();
-    Ok(vec![
+    let mut out = vec![
         Record::abs(
             c,
             format!(
@@ -891,17 +899,23 @@ fn slosh_load_convergence(quick: bool) -> Result<Vec<Record>> {
             fine_step.f_raw,
             0.05 * fine_step.f_raw,
         ),
-        Record::abs(
+    ];
+    // No chatter, on every run: the zero crossings of the raw load (every step) give the
+    // frequency of its spectral peak.
+    let all = meshes.iter().zip(&runs).map(|(m, r)| (name(m), h, r)).chain([(m1.clone(), h_fine, &fine_step)]);
+    for (m, hh, r) in all {
+        out.push(Record::abs(
             c,
             format!(
-                "no chatter, mesh {m2}: f1 from zero crossings of the RAW recorded load, every step (measured; \
-                 of the 51 ms moving average: {:.4} Hz) vs the spectral peak in 0.3-4 Hz (reference), tolerance 3 %, \
-                 h <= {h} s, {tag}",
-                fin.f_smoothed
+                "no chatter, mesh {m}, h <= {hh} s: f1 from zero crossings of the RAW recorded load, every step \
+                 (measured; of the 51 ms moving average: {:.4} Hz) vs the spectral peak in 0.3-4 Hz (reference), \
+                 tolerance 3 %, {tag}",
+                r.f_smoothed
             ),
-            fin.f_raw,
-            fin.f_spectral,
-            0.03 * fin.f_spectral,
-        ),
-    ])
+            r.f_raw,
+            r.f_spectral,
+            0.03 * r.f_spectral,
+        ));
+    }
+    Ok(out)
 }
