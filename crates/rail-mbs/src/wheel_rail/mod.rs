@@ -70,6 +70,7 @@ pub mod contact;
 pub mod creep;
 pub mod friction;
 pub mod hertz;
+pub mod kik_piotrowski;
 pub mod static_load;
 pub mod validate;
 
@@ -78,10 +79,12 @@ pub use contact::{
     WheelRailContact,
 };
 pub use creep::{
-    CreepForces, CreepModel, Creepages, KalkerCoefficients, creep_forces, kalker_coefficients, linear_coefficients,
+    CreepForces, CreepModel, Creepages, KalkerCoefficients, PatchStrip, creep_forces, fastsim_flexibilities,
+    fastsim_strips, kalker_coefficients, linear_coefficients,
 };
 pub use friction::FrictionMap;
 pub use hertz::{HertzConstants, Material, combined_modulus, elliptic_ke};
+pub use kik_piotrowski::{KpPatch, PatchModel, PatchSummary, QuadraticSeparation, SampledSeparation, SeparationFn};
 pub use static_load::{LoadedContact, VerticalTarget, WheelState, apply_creepages, solve_vertical};
 
 use thiserror::Error;
