@@ -482,6 +482,34 @@ def test_kik_piotrowski_patch_model(s1002_uic60):
     assert small["patch_area"].sum() < kp["patch_area"].sum()
 
 
+@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(
+    shift=st.floats(-0.012, 0.012),
+    yaw=st.floats(-0.03, 0.03),
+    load=st.floats(1e3, 2e5),
+    side=st.sampled_from(["left", "right"]),
+)
+def test_kik_piotrowski_contact_never_panics(s1002_uic60, shift, yaw, load, side):
+    wheel, head = s1002_uic60
+    try:
+        res = rail.contact(
+            wheel,
+            head,
+            side=side,
+            rail_cant=1 / 40,
+            lateral_shift=shift,
+            yaw=yaw,
+            load=load,
+            speed=20.0,
+            creep_model="fastsim",
+            patch_model="kik_piotrowski",
+        )
+    except (ValueError, rs.RailsloshError):
+        return
+    assert res["vertical_force"] == pytest.approx(load, rel=1e-6)
+    assert np.all(np.isfinite(res["normal_force"])) and np.all(res["patch_area"] > 0)
+
+
 @pytest.mark.parametrize(
     ("kwargs", "field"),
     [
