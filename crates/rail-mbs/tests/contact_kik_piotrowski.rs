@@ -237,11 +237,11 @@ fn pct(ours: f64, reference: f64) -> f64 {
 ///   interpenetration; KP's and CONTACT's reference point lie in the patch's centre);
 /// * lateral extent: from 0.5 to 6 mm shift both within ±7 % of CONTACT's map (whose
 ///   resolution is ±0.2 mm, 2–6 %); from 6.5 mm on (contact moving to the gauge corner)
-///   KP's patch is **wider** than CONTACT's, by 7–17.5 %, where Hertz stays within 5 %. The
+///   KP's patch is **wider** than CONTACT's, by 7–17.5 %, where Hertz stays within 5.1 %. The
 ///   elliptic-limit defect shows here (KP's axis ratio √(B/A) is too round: at B/A = 4.6 the
 ///   elliptic test gives a KP half-width √(1.1065/0.783) = 1.19 times Hertz's), so KP is
 ///   **not** closer to CONTACT's width at these cases, and its area is 4–7 % larger where
-///   Hertz's is 1.5–4 % smaller;
+///   Hertz's is 1–4 % smaller;
 /// * y = 0 (CONTACT's one wide 15.8 mm patch, 51.6 mm²): both models find two contact points;
 ///   KP's two adjacent patches span 15.9 mm / 51.4 mm² (Hertz 16.8 mm / 43.4 mm²) and give
 ///   FS within 4.2 % (Hertz −12 %), but their force-weighted reference point is 0.90 mm off

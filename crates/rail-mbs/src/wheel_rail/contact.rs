@@ -269,9 +269,11 @@ pub struct ContactGeometry {
 pub struct ContactPoint {
     /// Geometry.
     pub geometry: ContactGeometry,
-    /// Hertz constants (stiffness and ellipse scaling).
+    /// Hertz constants (stiffness and ellipse scaling) at the contact point's curvatures (the
+    /// normal force's law for [`PatchModel::Hertz`] only).
     pub hertz: HertzConstants,
-    /// Semi-axes `(a, b)` along `e1`, `e2`, m.
+    /// Semi-axes `(a, b)` along `e1`, `e2`, m: Hertz's ellipse, or the equivalent ellipse of a
+    /// Kik–Piotrowski patch (its area and length-to-width ratio).
     pub semi_axes: (f64, f64),
     /// Penetration rate `δ̇`, m/s.
     pub penetration_rate: f64,

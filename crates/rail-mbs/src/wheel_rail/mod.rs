@@ -19,7 +19,9 @@
 //!
 //! Normal force: Hertz `f_n = K_h δ^{3/2}(1 + d·δ̇)` (Hunt–Crossley damping with
 //! coefficient `d` in s/m, clamped at zero), with `K_h` and the ellipse semi-axes from the
-//! relative principal curvatures ([`hertz`]). Tangential force: creepages from the rigid
+//! relative principal curvatures ([`hertz`]); or, with [`PatchModel::KikPiotrowski`] on
+//! [`WheelRailContact::patch_model`], the non-elliptic Kik–Piotrowski patch from the profiles'
+//! separation across the contact ([`kik_piotrowski`]). Tangential force: creepages from the rigid
 //! body velocities and a creep law ([`creep`]; Shen–Hedrick–Elkins by default, Polach
 //! and FASTSIM with three flexibilities optional).
 //!
