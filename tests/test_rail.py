@@ -459,6 +459,75 @@ def test_a_lubricated_gauge_face_gives_each_contact_point_its_own_friction(s1002
         rail.contact(wheel, head, lateral_shift=0.0, friction_profile=[(0.0, 0.2), (0.0, 0.3)], **kw)
 
 
+def test_kik_piotrowski_patch_model(s1002_uic60):
+    """Issue 21, patch models: the Kik-Piotrowski patch carries the same load as Hertz, its pressure
+    centroid is the reference point, and Hertz stays the default (same result as naming it)."""
+    wheel, head = s1002_uic60
+    kw = dict(rail_cant=1 / 40, lateral_shift=0.004, load=50e3, speed=20.0, creep_model="fastsim")
+    hertz = rail.contact(wheel, head, **kw)
+    named = rail.contact(wheel, head, patch_model="hertz", **kw)
+    for key in ("height", "normal_force", "creep_lateral", "semi_axis_b"):
+        np.testing.assert_array_equal(hertz[key], named[key])
+    np.testing.assert_array_equal(hertz["reference_point"], hertz["point"])
+    kp = rail.contact(wheel, head, patch_model="kik_piotrowski", kp_epsilon=0.55, kp_strips=80, **kw)
+    assert kp["vertical_force"] == pytest.approx(50e3, rel=1e-9)
+    assert kp["normal_force"].sum() == pytest.approx(hertz["normal_force"].sum(), rel=0.02)
+    # a patch of the same size class as Hertz's ellipse, centred near the contact point
+    assert np.all(kp["patch_width"] > 0.5 * hertz["patch_width"].max())
+    assert np.all(kp["patch_width"] < 2.0 * hertz["patch_width"].max())
+    assert np.all(np.linalg.norm(kp["reference_point"] - kp["point"], axis=1) < 0.5 * kp["patch_width"])
+    assert np.all(np.isfinite(kp["creep_lateral"])) and np.all(kp["max_pressure"] > 0)
+    # the published epsilon 0.5 vs 0.55: a smaller virtual penetration, a smaller patch
+    small = rail.contact(wheel, head, patch_model="kik_piotrowski", kp_epsilon=0.5, **kw)
+    assert small["patch_area"].sum() < kp["patch_area"].sum()
+
+
+@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(
+    shift=st.floats(-0.012, 0.012),
+    yaw=st.floats(-0.03, 0.03),
+    load=st.floats(1e3, 2e5),
+    side=st.sampled_from(["left", "right"]),
+)
+def test_kik_piotrowski_contact_never_panics(s1002_uic60, shift, yaw, load, side):
+    wheel, head = s1002_uic60
+    try:
+        res = rail.contact(
+            wheel,
+            head,
+            side=side,
+            rail_cant=1 / 40,
+            lateral_shift=shift,
+            yaw=yaw,
+            load=load,
+            speed=20.0,
+            creep_model="fastsim",
+            patch_model="kik_piotrowski",
+        )
+    except (ValueError, rs.RailsloshError):
+        return
+    assert res["vertical_force"] == pytest.approx(load, rel=1e-6)
+    assert np.all(np.isfinite(res["normal_force"])) and np.all(res["patch_area"] > 0)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "field"),
+    [
+        (dict(patch_model="kp"), "patch_model"),
+        (dict(patch_model="kik_piotrowski", kp_epsilon=1.5), "kp_epsilon"),
+        (dict(patch_model="kik_piotrowski", kp_epsilon="big"), "kp_epsilon"),
+        (dict(patch_model="kik_piotrowski", kp_strips=2), "kp_strips"),
+        (dict(patch_model="kik_piotrowski", kp_strips=10.5), "kp_strips"),
+        (dict(kp_epsilon=0.55), "kp_epsilon"),
+    ],
+)
+def test_bad_patch_model_input_names_the_field(s1002_uic60, kwargs, field):
+    wheel, head = s1002_uic60
+    with pytest.raises(ValueError, match=f"`{field}`") as info:
+        rail.contact(wheel, head, rail_cant=1 / 40, load=50e3, **kwargs)
+    assert ": expected " in str(info.value)
+
+
 @pytest.mark.parametrize("mu", [0.3, 0.5])
 def test_a_wheel_pushed_into_flange_contact_climbs_at_the_nadal_limit(s1002_uic60, mu):
     """Issue 21 (derailment use), quasi-static: the left S1002 wheel carries 50 kN and slides on the

@@ -296,6 +296,9 @@ def wheel_rail_contact(
     young: float = 2.1e11,
     poisson: float = 0.3,
     scan_points: int = 400,
+    patch_model: str = "hertz",
+    kp_epsilon: float | None = None,
+    kp_strips: int | None = None,
 ) -> dict[str, Any]: ...
 
 # --- vehicle (crates/railslosh-py/src/vehicle.rs) ---

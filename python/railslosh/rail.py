@@ -379,6 +379,9 @@ def contact(
     young: float = 2.1e11,
     poisson: float = 0.3,
     scan_points: int = 400,
+    patch_model: str = "hertz",
+    kp_epsilon: float | None = None,
+    kp_strips: int | None = None,
 ) -> dict[str, Any]:
     """Contact of one wheel of a wheelset on its straight rail, at the height that carries ``load``
     (total vertical force on the wheel, N) or reaches ``penetration`` (largest contact penetration,
@@ -404,6 +407,14 @@ def contact(
     outside), each contact point taking the μ of its own location (e.g.
     :func:`lubricated_gauge_face`); the result's ``friction`` gives the μ of each point.
 
+    Patch model: ``patch_model="hertz"`` (Hertz's ellipse from the curvatures at the contact point,
+    the default) or ``"kik_piotrowski"``: the non-elliptic patch of Kik & Piotrowski (2008) from the
+    profiles' separation across the contact, for the gauge corner and flange where the curvature
+    varies across the patch; ``kp_epsilon`` is its virtual-penetration factor (default 0.55, in
+    [0.05, 1]) and ``kp_strips`` its number of strips (default 60, 4–5000). FASTSIM then runs on the
+    patch's strips; the other creep laws use its equivalent ellipse (same area and length-to-width
+    ratio), which ``semi_axis_a`` / ``semi_axis_b`` report.
+
     The wheel is lowered onto the rail from 50 mm above its nominal height, so for a shift beyond
     flange contact (about 8 mm for S1002 on UIC 60) the flange may land on the rail head (a derailed
     position) instead of pressing against the gauge face.
@@ -414,8 +425,10 @@ def contact(
     (rail / wheel profile coordinates, m), ``rolling_radius``, ``contact_angle`` (rad from vertical),
     ``penetration``, ``normal_force``, ``creep_longitudinal``, ``creep_lateral`` (N, on the wheel
     along the contact axes e1 forward and e2 to the left), ``spin_moment`` (N m), ``semi_axis_a``
-    (along the rolling direction), ``semi_axis_b`` (m), ``max_pressure`` (Pa), arrays of shape (n, 3)
-    ``creepages``, ``point``, ``normal``, ``e1``, ``e2``, ``force_on_wheel``, and ``method``.
+    (along the rolling direction), ``semi_axis_b`` (m), ``max_pressure`` (Pa), ``patch_area`` (m²),
+    ``patch_width`` (lateral extent of the patch, m), arrays of shape (n, 3) ``creepages``, ``point``,
+    ``reference_point`` (the pressure centroid of a Kik–Piotrowski patch; ``point`` for Hertz),
+    ``normal``, ``e1``, ``e2``, ``force_on_wheel``, and ``method``.
     """
     if creepages is not None:
         c = _floats(creepages, "creepages")
@@ -455,6 +468,9 @@ def contact(
         creep_parameters=None if creep_parameters is None else dict(creep_parameters),
         friction_profile=table,
         scan_points=int(scan_points),
+        patch_model=patch_model,
+        kp_epsilon=None if kp_epsilon is None else _number(kp_epsilon, "kp_epsilon"),
+        kp_strips=None if kp_strips is None else _count(kp_strips, "kp_strips"),
         **kwargs,
     )
 
@@ -479,6 +495,12 @@ def _number(x: Any, field: str) -> float:
         return float(x)
     except (TypeError, ValueError) as exc:
         raise ValueError(f"invalid `{field}` = {x!r}: expected a number") from exc
+
+
+def _count(x: Any, field: str) -> int:
+    if isinstance(x, bool) or not isinstance(x, (int, np.integer)):
+        raise ValueError(f"invalid `{field}` = {x!r}: expected a whole number")
+    return int(x)
 
 
 __all__ = [

@@ -17,8 +17,8 @@ use rail_mbs::profile::{self, Profile, ProfileError, ProfileKind};
 use rail_mbs::track::{INCH, Side, Track, TrackError, TrackPoint};
 use rail_mbs::wheel_rail::validate::ValidationError;
 use rail_mbs::wheel_rail::{
-    ContactError, CreepModel, Creepages, FrictionMap, Material, RailGeometry, RailPath, VerticalTarget, WheelGeometry,
-    WheelRailContact, WheelState, solve_vertical,
+    ContactError, CreepModel, Creepages, FrictionMap, Material, PatchModel, RailGeometry, RailPath, VerticalTarget,
+    WheelGeometry, WheelRailContact, WheelState, kik_piotrowski, solve_vertical,
 };
 
 use crate::RailsloshError;
@@ -671,6 +671,32 @@ fn creep_model_of(name: &str, params: Option<&Bound<'_, PyDict>>) -> PyResult<Cr
     }
 }
 
+/// The patch model `name` ("hertz" or "kik_piotrowski") with the Kik–Piotrowski options
+/// `kp_epsilon` (virtual-penetration factor, default 0.55) and `kp_strips` (default 60), which
+/// only "kik_piotrowski" takes.
+fn patch_model_of(name: &str, epsilon: Option<f64>, strips: Option<i64>) -> PyResult<PatchModel> {
+    match name {
+        "hertz" => {
+            if let Some(e) = epsilon {
+                return Err(invalid("kp_epsilon", e, "None with patch_model \"hertz\""));
+            }
+            if let Some(n) = strips {
+                return Err(invalid("kp_strips", n, "None with patch_model \"hertz\""));
+            }
+            Ok(PatchModel::Hertz)
+        }
+        "kik_piotrowski" => {
+            let (lo, hi) = kik_piotrowski::EPSILON_RANGE;
+            let epsilon = in_range("kp_epsilon", epsilon.unwrap_or(kik_piotrowski::DEFAULT_EPSILON), lo, hi, "")?;
+            let (slo, shi) = kik_piotrowski::STRIPS_RANGE;
+            let strips =
+                count_in("kp_strips", strips.unwrap_or(kik_piotrowski::DEFAULT_STRIPS as i64), slo as i64, shi as i64)?;
+            Ok(PatchModel::KikPiotrowski { epsilon, strips })
+        }
+        other => Err(invalid("patch_model", format!("{other:?}"), "one of \"hertz\", \"kik_piotrowski\"")),
+    }
+}
+
 /// One wheel on its straight rail at the height carrying `load` (N, total vertical force
 /// on the wheel) or reaching `penetration` (m); see `railslosh.rail.contact`.
 #[pyfunction]
@@ -678,7 +704,8 @@ fn creep_model_of(name: &str, params: Option<&Bound<'_, PyDict>>) -> PyResult<Cr
                     gauge=1.435, gauge_depth=0.014, rail_cant=0.0, trim_slope=None, lateral_shift=0.0, yaw=0.0,
                     roll=0.0, load=None, penetration=None, speed=0.0, lateral_velocity=0.0, yaw_rate=0.0,
                     axle_rate=None, creepages=None, creep_model="shen-hedrick-elkins", creep_parameters=None,
-                    friction=0.3, friction_profile=None, young=2.1e11, poisson=0.3, scan_points=400))]
+                    friction=0.3, friction_profile=None, young=2.1e11, poisson=0.3, scan_points=400,
+                    patch_model="hertz", kp_epsilon=None, kp_strips=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn wheel_rail_contact<'py>(
     py: Python<'py>,
@@ -709,6 +736,9 @@ pub fn wheel_rail_contact<'py>(
     young: f64,
     poisson: f64,
     scan_points: i64,
+    patch_model: &str,
+    kp_epsilon: Option<f64>,
+    kp_strips: Option<i64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let side = side_of(side)?;
     let friction_map = match friction_profile {
@@ -759,6 +789,7 @@ pub fn wheel_rail_contact<'py>(
         }
     };
     let model = creep_model_of(creep_model, creep_parameters)?;
+    let patch = patch_model_of(patch_model, kp_epsilon, kp_strips)?;
     if let Some(o) = rail_offset {
         in_range("rail_offset", o, 0.3, 1.2, "m")?;
     }
@@ -796,6 +827,7 @@ pub fn wheel_rail_contact<'py>(
     contact.friction = friction;
     contact.friction_map = friction_map;
     contact.creep_model = model;
+    contact.patch_model = patch;
     contact.settings.scan_points = scan_points;
     let state = WheelState { lateral_shift, yaw, roll, speed, lateral_velocity, yaw_rate, axle_rate, creepages };
     let res = guarded(py, move || {
@@ -825,7 +857,19 @@ pub fn wheel_rail_contact<'py>(
     d.set_item("spin_moment", arr(py, col(&|p| p.creep.spin_moment)))?;
     d.set_item("semi_axis_a", arr(py, col(&|p| p.semi_axes.0)))?;
     d.set_item("semi_axis_b", arr(py, col(&|p| p.semi_axes.1)))?;
-    d.set_item("max_pressure", arr(py, col(&|p| p.hertz.max_pressure(p.normal_force))))?;
+    d.set_item(
+        "max_pressure",
+        arr(py, col(&|p| p.patch.map_or_else(|| p.hertz.max_pressure(p.normal_force), |s| s.max_pressure))),
+    )?;
+    d.set_item(
+        "patch_area",
+        arr(py, col(&|p| p.patch.map_or(std::f64::consts::PI * p.semi_axes.0 * p.semi_axes.1, |s| s.area))),
+    )?;
+    d.set_item(
+        "patch_width",
+        arr(py, col(&|p| p.patch.map_or(2.0 * p.semi_axes.1, |s| s.lateral_extent.1 - s.lateral_extent.0))),
+    )?;
+    d.set_item("reference_point", arr3(py, vec3(&|p| p.reference_point().into()))?)?;
     d.set_item(
         "creepages",
         arr3(py, pts.iter().map(|p| [p.creepages.longitudinal, p.creepages.lateral, p.creepages.spin]).collect())?,

@@ -7,6 +7,7 @@ use nalgebra::{Matrix3, Matrix4, Vector3, Vector4};
 use super::ContactError;
 use super::creep::{CreepForces, CreepModel, Creepages, creep_forces};
 use super::hertz::{HertzConstants, Material, combined_modulus};
+use super::kik_piotrowski::{KpPatch, PatchModel, PatchSummary, SampledSeparation};
 use crate::profile::Profile;
 use crate::track::{Side, Track};
 
@@ -268,9 +269,11 @@ pub struct ContactGeometry {
 pub struct ContactPoint {
     /// Geometry.
     pub geometry: ContactGeometry,
-    /// Hertz constants (stiffness and ellipse scaling).
+    /// Hertz constants (stiffness and ellipse scaling) at the contact point's curvatures (the
+    /// normal force's law for [`PatchModel::Hertz`] only).
     pub hertz: HertzConstants,
-    /// Semi-axes `(a, b)` along `e1`, `e2`, m.
+    /// Semi-axes `(a, b)` along `e1`, `e2`, m: Hertz's ellipse, or the equivalent ellipse of a
+    /// Kik–Piotrowski patch (its area and length-to-width ratio).
     pub semi_axes: (f64, f64),
     /// Penetration rate `δ̇`, m/s.
     pub penetration_rate: f64,
@@ -280,6 +283,9 @@ pub struct ContactPoint {
     pub creepages: Creepages,
     /// Creep forces on the wheel (along `e1`, `e2`, about `n`).
     pub creep: CreepForces,
+    /// The non-elliptic patch of [`PatchModel::KikPiotrowski`] (`None` for Hertz, whose
+    /// patch is the ellipse of `semi_axes`).
+    pub patch: Option<PatchSummary>,
 }
 
 impl ContactPoint {
@@ -288,11 +294,25 @@ impl ContactPoint {
         let g = &self.geometry;
         g.normal * self.normal_force + g.e1 * self.creep.longitudinal + g.e2 * self.creep.lateral
     }
-    /// Moment on the wheel about point `about` (e.g. the wheelset centre), N·m.
+    /// Moment on the wheel about point `about` (e.g. the wheelset centre), N·m. The creep
+    /// forces and spin moment act at the contact point; a Kik–Piotrowski patch's normal
+    /// force acts at its pressure centroid ([`Self::reference_point`]).
     pub fn moment_on_wheel(&self, about: &Vector3<f64>) -> Vector3<f64> {
         let g = &self.geometry;
         let p = 0.5 * (g.point_rail + g.point_wheel);
-        (p - about).cross(&self.force_on_wheel()) + g.normal * self.creep.spin_moment
+        let m = (p - about).cross(&self.force_on_wheel()) + g.normal * self.creep.spin_moment;
+        match &self.patch {
+            None => m,
+            Some(s) => m + (g.e2 * s.centroid).cross(&(g.normal * self.normal_force)),
+        }
+    }
+    /// Contact reference point, m: the pressure centroid of a Kik–Piotrowski patch, the
+    /// contact point ([`Self::point`]) for Hertz.
+    pub fn reference_point(&self) -> Vector3<f64> {
+        match &self.patch {
+            None => self.point(),
+            Some(s) => self.point() + self.geometry.e2 * s.centroid,
+        }
     }
     /// Contact point (midway between the surface points), m.
     pub fn point(&self) -> Vector3<f64> {
@@ -318,6 +338,9 @@ pub struct WheelRailContact {
     pub friction_map: Option<std::sync::Arc<super::FrictionMap>>,
     /// Creep law.
     pub creep_model: CreepModel,
+    /// Normal-contact patch model (Hertz by default; [`PatchModel::KikPiotrowski`] for the
+    /// non-elliptic patch of the gauge corner and flange).
+    pub patch_model: PatchModel,
     /// Hunt–Crossley damping coefficient `d` in `f_n = K_h δ^{3/2}(1 + d δ̇)`, s/m.
     pub damping: f64,
     /// Search settings.
@@ -353,6 +376,7 @@ impl WheelRailContact {
             friction: 0.3,
             friction_map: None,
             creep_model: CreepModel::ShenHedrickElkins,
+            patch_model: PatchModel::Hertz,
             damping: 0.0,
             settings: ContactSettings::default(),
             previous: Vec::new(),
@@ -512,6 +536,18 @@ impl WheelRailContact {
     /// returns `(gap, [s, v, u, θ])`, `gap = +∞` when off the rail profile.
     fn scan_gap(&self, pose: &WheelPose, s0: f64, fd: &RailFrameDerivs, u: f64) -> (f64, [f64; 4]) {
         let sg = self.rail.side.sign();
+        let (p, th) = self.wheel_section(pose, fd, u);
+        let v = sg * p.y;
+        let (lo, hi) = self.rail.profile.y_range();
+        if v < lo || v > hi {
+            return (f64::INFINITY, [s0, v, u, th]);
+        }
+        (p.z - self.rail.profile.z(v), [s0 + p.x, v, u, th])
+    }
+
+    /// Lowest point of the wheel circle at lateral profile coordinate `u` in the rail frame
+    /// `fd` (its coordinates `p` in that frame) and its angle `θ`.
+    fn wheel_section(&self, pose: &WheelPose, fd: &RailFrameDerivs, u: f64) -> (Vector3<f64>, f64) {
         let mt = fd.rot.transpose();
         let w0 = self.wheel.surface(u, 0.0);
         let centre = pose.position + pose.rotation * Vector3::new(0.0, w0[0].y, 0.0);
@@ -520,13 +556,94 @@ impl WheelRailContact {
         let cl = mt * (centre - fd.origin);
         let th = (-a.z).atan2(b.z);
         let rho = self.wheel.nominal_radius - self.wheel.profile.z(u);
-        let p = cl + (a * th.sin() - b * th.cos()) * rho;
-        let v = sg * p.y;
-        let (lo, hi) = self.rail.profile.y_range();
-        if v < lo || v > hi {
-            return (f64::INFINITY, [s0, v, u, th]);
+        (cl + (a * th.sin() - b * th.cos()) * rho, th)
+    }
+
+    /// The undeformed separation across contact `g` for the Kik–Piotrowski patch
+    /// ([`super::kik_piotrowski`]): in the rail's cross-section at the contact point, the
+    /// distance along the rail normal between the wheel (the lowest points of its circles)
+    /// and the rail as a function of the lateral coordinate `y` along the contact plane
+    /// (oriented with `e2`, 0 at the contact point, `h(0) = 0`), sampled every `spacing` m
+    /// over `|y| ≤ half_width` (less where a profile ends), with the relative longitudinal
+    /// curvature `A(y) = A(0) ρ(u_c)/ρ(u(y))` of the wheel's in-situ radius.
+    pub fn separation(
+        &self,
+        pose: &WheelPose,
+        g: &ContactGeometry,
+        half_width: f64,
+        spacing: f64,
+    ) -> Result<SampledSeparation, ContactError> {
+        let sg = self.rail.side.sign();
+        let fd = self.rail.frame_derivs(g.params[0]);
+        let (vc, uc) = (g.params[1], g.params[2]);
+        let (zc, dzc, _) = self.rail.profile.eval(vc);
+        let norm = (1.0 + dzc * dzc).sqrt();
+        let (tv, tz) = (1.0 / norm, dzc / norm);
+        // (τ, ζ): along the rail's tangent and normal at the contact point.
+        let local = |v: f64, z: f64| ((v - vc) * tv + (z - zc) * tz, (z - zc) * tv - (v - vc) * tz);
+        let rail = |v: f64| local(v, self.rail.profile.z(v));
+        let wheel = |u: f64| {
+            let (p, _) = self.wheel_section(pose, &fd, u);
+            local(sg * p.y, p.z)
+        };
+        // Parameter of `curve` on `range` with τ = target, by Newton from `start`
+        // (central-difference slope); None when it leaves the range.
+        let solve = |curve: &dyn Fn(f64) -> (f64, f64), range: (f64, f64), start: f64, target: f64| {
+            let mut p = start;
+            for _ in 0..30 {
+                let f = curve(p).0 - target;
+                if f.abs() < 1e-13 {
+                    return Some(p);
+                }
+                let h = 1e-7;
+                let (a, b) = ((p - h).max(range.0), (p + h).min(range.1));
+                let slope = (curve(b).0 - curve(a).0) / (b - a);
+                if slope.is_nan() || slope.abs() <= 1e-6 {
+                    return None;
+                }
+                let next = p - f / slope;
+                if !(next >= range.0 && next <= range.1) {
+                    return None;
+                }
+                p = next;
+            }
+            Some(p).filter(|&p| (curve(p).0 - target).abs() < 1e-10)
+        };
+        let k_half = ((half_width / spacing).round() as usize).max(2);
+        let (rr, wr) = (self.rail.profile.y_range(), self.wheel.profile.y_range());
+        let rho = |u: f64| self.wheel.nominal_radius - self.wheel.profile.z(u);
+        let rho_c = rho(uc);
+        let a0 = g.curvature_x.max(self.settings.min_relative_curvature);
+        // March outward from the contact point in both directions.
+        let mut samples: Vec<(f64, f64, f64)> = Vec::with_capacity(2 * k_half + 1);
+        for dir in [-1.0, 1.0] {
+            let (mut v, mut u) = (vc, uc);
+            for k in 0..=k_half {
+                if dir > 0.0 && k == 0 {
+                    continue;
+                }
+                let tau = dir * spacing * k as f64;
+                let (Some(v1), Some(u1)) = (solve(&rail, rr, v, tau), solve(&wheel, wr, u, tau)) else { break };
+                (v, u) = (v1, u1);
+                samples.push((tau, wheel(u).1 - rail(v).1, a0 * rho_c / rho(u)));
+            }
         }
-        (p.z - self.rail.profile.z(v), [s0 + p.x, v, u, th])
+        samples.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let h0 = samples.iter().find(|s| s.0 == 0.0).map(|s| s.1).ok_or_else(|| {
+            ContactError::InvalidInput("separation: the contact point is not on both profiles' cross-sections".into())
+        })?;
+        // Orient y with e2.
+        let t3 = fd.rot * Vector3::new(0.0, sg * tv, tz);
+        let flip = t3.dot(&g.e2) < 0.0;
+        if flip {
+            samples.reverse();
+        }
+        let sign = if flip { -1.0 } else { 1.0 };
+        SampledSeparation::new(
+            samples.iter().map(|s| sign * s.0).collect(),
+            samples.iter().map(|s| s.1 - h0).collect(),
+            samples.iter().map(|s| s.2).collect(),
+        )
     }
 
     /// Seeds `(gap, q, u_lo, u_hi)` at the local minima of the scan gap, into `seeds`
@@ -709,9 +826,38 @@ impl WheelRailContact {
         let (mut geoms, mut out) =
             (std::mem::take(&mut self.scratch.geometry), std::mem::take(&mut self.scratch.points));
         let result =
-            self.find_geometry_into(pose, &mut geoms).and_then(|()| self.loaded_points(pose, &geoms, &mut out));
+            self.find_geometry_into(pose, &mut geoms).and_then(|()| self.loaded_points(pose, &geoms, None, &mut out));
         (self.scratch.geometry, self.scratch.points) = (geoms, out);
         result.map(|()| self.scratch.points.as_slice())
+    }
+
+    /// [`Self::evaluate`] with prescribed creepages (the same at every point, CONTACT's
+    /// "creepage prescribed" mode) instead of the kinematic ones; the creep forces come from
+    /// the patch model's patch (the strips of a Kik–Piotrowski patch for FASTSIM).
+    pub fn evaluate_with_creepages(
+        &mut self,
+        pose: &WheelPose,
+        creepages: &Creepages,
+    ) -> Result<Vec<ContactPoint>, ContactError> {
+        let mut geoms = Vec::new();
+        self.find_geometry_into(pose, &mut geoms)?;
+        let mut out = Vec::new();
+        self.loaded_points(pose, &geoms, Some(creepages), &mut out)?;
+        Ok(out)
+    }
+
+    /// The Kik–Piotrowski patch of contact `g` at its penetration (module
+    /// [`super::kik_piotrowski`]; separation sampled every 0.05 mm over ±25 mm).
+    pub fn kik_piotrowski_patch(
+        &self,
+        pose: &WheelPose,
+        g: &ContactGeometry,
+        epsilon: f64,
+        strips: usize,
+    ) -> Result<KpPatch, ContactError> {
+        let sep = self.separation(pose, g, KP_SEPARATION_HALF_WIDTH, KP_SEPARATION_SPACING)?;
+        let e_star = combined_modulus(&self.wheel_material, &self.rail_material);
+        KpPatch::at_penetration(&sep, g.penetration, epsilon, strips, e_star)
     }
 
     /// The geometries in contact (`δ > 0`) with their normal and creep forces, into `out`.
@@ -719,9 +865,13 @@ impl WheelRailContact {
         &self,
         pose: &WheelPose,
         geoms: &[ContactGeometry],
+        prescribed: Option<&Creepages>,
         out: &mut Vec<ContactPoint>,
     ) -> Result<(), ContactError> {
         out.clear();
+        if let PatchModel::KikPiotrowski { epsilon, strips } = self.patch_model {
+            return self.loaded_points_kp(pose, geoms, prescribed, epsilon, strips, out);
+        }
         let e_star = combined_modulus(&self.wheel_material, &self.rail_material);
         let g_mod = 2.0 / (1.0 / self.wheel_material.shear_modulus() + 1.0 / self.rail_material.shear_modulus());
         let nu = 0.5 * (self.wheel_material.poisson + self.rail_material.poisson);
@@ -735,11 +885,11 @@ impl WheelRailContact {
             let fe = hertz.force(g.penetration);
             let fn_ = (fe * (1.0 + self.damping * pen_rate)).max(0.0);
             let speed = pose.velocity.norm().max(self.settings.min_speed);
-            let creepages = Creepages {
+            let creepages = prescribed.copied().unwrap_or(Creepages {
                 longitudinal: v.dot(&g.e1) / speed,
                 lateral: v.dot(&g.e2) / speed,
                 spin: pose.angular_velocity.dot(&g.normal) / speed,
-            };
+            });
             let (a, b) = hertz.semi_axes(fn_);
             let creep = creep_forces(self.creep_model, &creepages, a, b, fn_, self.friction_at(&g.params), g_mod, nu);
             out.push(ContactPoint {
@@ -750,11 +900,81 @@ impl WheelRailContact {
                 normal_force: fn_,
                 creepages,
                 creep,
+                patch: None,
+            });
+        }
+        Ok(())
+    }
+
+    /// [`Self::loaded_points`] with Kik–Piotrowski patches. A contact point that lies inside
+    /// the patch of a deeper one (CONTACT's one wide patch where the search finds two
+    /// points) is dropped: the deeper point's patch covers it.
+    fn loaded_points_kp(
+        &self,
+        pose: &WheelPose,
+        geoms: &[ContactGeometry],
+        prescribed: Option<&Creepages>,
+        epsilon: f64,
+        strips: usize,
+        out: &mut Vec<ContactPoint>,
+    ) -> Result<(), ContactError> {
+        self.patch_model.validate()?;
+        let e_star = combined_modulus(&self.wheel_material, &self.rail_material);
+        let g_mod = 2.0 / (1.0 / self.wheel_material.shear_modulus() + 1.0 / self.rail_material.shear_modulus());
+        let nu = 0.5 * (self.wheel_material.poisson + self.rail_material.poisson);
+        let kmin = self.settings.min_relative_curvature;
+        let mut loaded: Vec<(ContactGeometry, KpPatch)> = Vec::new();
+        for &g in geoms.iter().filter(|g| g.penetration > 0.0) {
+            loaded.push((g, self.kik_piotrowski_patch(pose, &g, epsilon, strips)?));
+        }
+        // deepest first; drop points inside an already kept patch
+        loaded.sort_by(|a, b| b.0.penetration.total_cmp(&a.0.penetration));
+        let mut kept: Vec<(ContactGeometry, KpPatch)> = Vec::new();
+        for (g, patch) in loaded {
+            let p = 0.5 * (g.point_rail + g.point_wheel);
+            let covered = kept.iter().any(|(k, kp)| {
+                let y = (p - 0.5 * (k.point_rail + k.point_wheel)).dot(&k.e2);
+                y >= kp.lateral_extent.0 && y <= kp.lateral_extent.1
+            });
+            if !covered {
+                kept.push((g, patch));
+            }
+        }
+        kept.sort_by(|a, b| a.0.params[2].total_cmp(&b.0.params[2]));
+        for (g, patch) in kept {
+            let hertz = HertzConstants::new(g.curvature_x.max(kmin), g.curvature_y.max(kmin), e_star)?;
+            let p = 0.5 * (g.point_rail + g.point_wheel);
+            let r = p - pose.position;
+            let v = pose.velocity + pose.angular_velocity.cross(&r);
+            let pen_rate = -v.dot(&g.normal);
+            let fn_ = (patch.normal_force * (1.0 + self.damping * pen_rate)).max(0.0);
+            let patch = patch.scaled_to(fn_);
+            let speed = pose.velocity.norm().max(self.settings.min_speed);
+            let creepages = prescribed.copied().unwrap_or(Creepages {
+                longitudinal: v.dot(&g.e1) / speed,
+                lateral: v.dot(&g.e2) / speed,
+                spin: pose.angular_velocity.dot(&g.normal) / speed,
+            });
+            let creep = patch.creep(self.creep_model, &creepages, self.friction_at(&g.params), g_mod, nu);
+            out.push(ContactPoint {
+                geometry: g,
+                hertz,
+                semi_axes: patch.equivalent_ellipse(),
+                penetration_rate: pen_rate,
+                normal_force: fn_,
+                creepages,
+                creep,
+                patch: Some(patch.summary()),
             });
         }
         Ok(())
     }
 }
+
+/// Half-width of the separation sampled for a Kik–Piotrowski patch, m.
+pub const KP_SEPARATION_HALF_WIDTH: f64 = 0.025;
+/// Spacing of the separation samples of a Kik–Piotrowski patch, m.
+pub const KP_SEPARATION_SPACING: f64 = 5e-5;
 
 /// Convex curvature tensor of a surface in the basis `(e1, e2)` of the common tangent
 /// plane. `sign = −1` when `n` is the outward normal of the surface, `+1` when `−n` is.

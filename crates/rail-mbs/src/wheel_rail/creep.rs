@@ -206,19 +206,75 @@ pub fn creep_forces(model: CreepModel, c: &Creepages, a: f64, b: f64, n: f64, mu
     CreepForces { longitudinal: factor * fx, lateral: factor * fy, spin_moment: factor * mz }
 }
 
-/// FASTSIM on an elliptical patch (see [`CreepModel::Fastsim`]); forces on the wheel.
-#[allow(clippy::too_many_arguments)]
-fn fastsim(c: &Creepages, a: f64, b: f64, n: f64, mu: f64, g: f64, nu: f64, nx: usize, ny: usize) -> CreepForces {
+/// One strip of a contact patch across the rolling direction, for FASTSIM on a
+/// non-elliptic patch ([`fastsim_strips`]): the pressure along the strip is
+/// semi-elliptic, `p(x) = peak_pressure · √(1 − (x/half_length)²)` on `|x| ≤ half_length`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PatchStrip {
+    /// Lateral position of the strip's centre line, m, relative to the point where the
+    /// creepages are defined (the spin creepage's lever arm).
+    pub y: f64,
+    /// Width of the strip, m.
+    pub width: f64,
+    /// Half-length of the strip along the rolling direction, m (the strip spans
+    /// `−half_length ≤ x ≤ half_length`).
+    pub half_length: f64,
+    /// Pressure at `x = 0` of the strip, Pa.
+    pub peak_pressure: f64,
+}
+
+/// Kalker's three flexibilities of the simplified theory `(L1, L2, L3)` (m/Pa) for an
+/// ellipse with semi-axes `a` (rolling), `b`, shear modulus `g` and Poisson's ratio `nu`:
+/// `L1 = 8a/(3 C11 G)`, `L2 = 8a/(3 C22 G)`, `L3 = π a √(a/b) / (4 C23 G)`.
+pub fn fastsim_flexibilities(a: f64, b: f64, g: f64, nu: f64) -> [f64; 3] {
     let k = kalker_coefficients(a / b, nu);
     let l1 = 8.0 * a / (3.0 * k.c11 * g);
     let l2 = 8.0 * a / (3.0 * k.c22 * g);
     let l3 = std::f64::consts::PI * a * (a / b).sqrt() / (4.0 * k.c23 * g);
+    [l1, l2, l3]
+}
+
+/// FASTSIM on an elliptical patch (see [`CreepModel::Fastsim`]); forces on the wheel.
+/// The ellipse is the strip patch of `ny` strips of width `2b/ny` with half-lengths
+/// `a √(1 − (y/b)²)` and the Hertzian traction bound, run by the one FASTSIM
+/// ([`fastsim_on_strips`]).
+#[allow(clippy::too_many_arguments)]
+fn fastsim(c: &Creepages, a: f64, b: f64, n: f64, mu: f64, g: f64, nu: f64, nx: usize, ny: usize) -> CreepForces {
+    let flex = fastsim_flexibilities(a, b, g, nu);
     let p0 = 3.0 * n / (2.0 * std::f64::consts::PI * a * b);
     let dy = 2.0 * b / ny as f64;
-    let (mut fx, mut fy, mut mz) = (0.0, 0.0, 0.0);
-    for j in 0..ny {
+    let strips = (0..ny).map(|j| {
         let y = -b + (j as f64 + 0.5) * dy;
-        let ay = a * (1.0 - (y / b).powi(2)).max(0.0).sqrt();
+        (y, dy, a * (1.0 - (y / b).powi(2)).max(0.0).sqrt())
+    });
+    fastsim_on_strips(c, flex, nx, strips, |x, y, _| {
+        mu * p0 * (1.0 - (x / a).powi(2) - (y / b).powi(2)).max(0.0).sqrt()
+    })
+}
+
+/// FASTSIM (Kalker's simplified theory, three flexibilities `flex = [L1, L2, L3]`) on a
+/// patch given as strips across the rolling direction ([`PatchStrip`]), each of `nx`
+/// cells marched from its leading edge `x = +half_length`, with the traction bound
+/// `μ p(x, y)` of its semi-elliptic pressure. Forces on the wheel; the spin moment is
+/// about the point where the creepages are defined (`y = 0`, `x = 0`).
+pub fn fastsim_strips(c: &Creepages, strips: &[PatchStrip], flex: [f64; 3], mu: f64, nx: usize) -> CreepForces {
+    let nx = nx.max(2);
+    fastsim_on_strips(c, flex, nx, strips.iter().map(|s| (s.y, s.width, s.half_length)), |x, _, j| {
+        let s = &strips[j];
+        mu * s.peak_pressure * (1.0 - (x / s.half_length).powi(2)).max(0.0).sqrt()
+    })
+}
+
+/// The one FASTSIM: strips `(y, width, half_length)` and the traction bound
+/// `bound(x, y, strip index)`.
+fn fastsim_on_strips<S, B>(c: &Creepages, flex: [f64; 3], nx: usize, strips: S, bound: B) -> CreepForces
+where
+    S: Iterator<Item = (f64, f64, f64)>,
+    B: Fn(f64, f64, usize) -> f64,
+{
+    let [l1, l2, l3] = flex;
+    let (mut fx, mut fy, mut mz) = (0.0, 0.0, 0.0);
+    for (j, (y, dy, ay)) in strips.enumerate() {
         if ay <= 0.0 {
             continue;
         }
@@ -229,7 +285,7 @@ fn fastsim(c: &Creepages, a: f64, b: f64, n: f64, mu: f64, g: f64, nu: f64, nx: 
             let x = ay - (i as f64 + 0.5) * dx;
             px -= (c.longitudinal / l1 - c.spin * y / l3) * dx;
             py -= (c.lateral / l2 + c.spin * x / l3) * dx;
-            let bound = mu * p0 * (1.0 - (x / a).powi(2) - (y / b).powi(2)).max(0.0).sqrt();
+            let bound = bound(x, y, j);
             let mag = (px * px + py * py).sqrt();
             if mag > bound && mag > 0.0 {
                 px *= bound / mag;

@@ -19,7 +19,9 @@
 //!
 //! Normal force: Hertz `f_n = K_h δ^{3/2}(1 + d·δ̇)` (Hunt–Crossley damping with
 //! coefficient `d` in s/m, clamped at zero), with `K_h` and the ellipse semi-axes from the
-//! relative principal curvatures ([`hertz`]). Tangential force: creepages from the rigid
+//! relative principal curvatures ([`hertz`]); or, with [`PatchModel::KikPiotrowski`] on
+//! [`WheelRailContact::patch_model`], the non-elliptic Kik–Piotrowski patch from the profiles'
+//! separation across the contact ([`kik_piotrowski`]). Tangential force: creepages from the rigid
 //! body velocities and a creep law ([`creep`]; Shen–Hedrick–Elkins by default, Polach
 //! and FASTSIM with three flexibilities optional).
 //!
@@ -70,6 +72,7 @@ pub mod contact;
 pub mod creep;
 pub mod friction;
 pub mod hertz;
+pub mod kik_piotrowski;
 pub mod static_load;
 pub mod validate;
 
@@ -78,10 +81,12 @@ pub use contact::{
     WheelRailContact,
 };
 pub use creep::{
-    CreepForces, CreepModel, Creepages, KalkerCoefficients, creep_forces, kalker_coefficients, linear_coefficients,
+    CreepForces, CreepModel, Creepages, KalkerCoefficients, PatchStrip, creep_forces, fastsim_flexibilities,
+    fastsim_strips, kalker_coefficients, linear_coefficients,
 };
 pub use friction::FrictionMap;
 pub use hertz::{HertzConstants, Material, combined_modulus, elliptic_ke};
+pub use kik_piotrowski::{KpPatch, PatchModel, PatchSummary, QuadraticSeparation, SampledSeparation, SeparationFn};
 pub use static_load::{LoadedContact, VerticalTarget, WheelState, apply_creepages, solve_vertical};
 
 use thiserror::Error;

@@ -144,11 +144,12 @@ pub fn solve_vertical(
         other => return Err(ContactError::InvalidInput(format!("target {other:?} must be positive and finite"))),
     };
     let loaded = |c: &mut WheelRailContact, pose: &WheelPose| -> Result<Vec<ContactPoint>, ContactError> {
-        let mut pts = c.evaluate(pose)?;
-        if let Some(cr) = &state.creepages {
-            apply_creepages(c, &mut pts, cr);
+        match &state.creepages {
+            // the same as `evaluate` then `apply_creepages` for Hertz; the patch's own strips
+            // for a Kik–Piotrowski patch
+            Some(cr) => c.evaluate_with_creepages(pose, cr),
+            None => c.evaluate(pose),
         }
-        Ok(pts)
     };
     let measure = |c: &mut WheelRailContact, z: f64| -> Result<f64, ContactError> {
         let pose = state.pose(r0, z);
@@ -218,7 +219,9 @@ pub fn solve_vertical(
 
 /// Replaces the creepages of `points` by `creepages` and recomputes their creep forces with
 /// the creep law, friction and materials of `contact` (as [`WheelRailContact::evaluate`]
-/// does for kinematic creepages).
+/// does for kinematic creepages) on each point's ellipse `semi_axes` (for a
+/// Kik–Piotrowski patch its equivalent ellipse; [`WheelRailContact::evaluate_with_creepages`]
+/// uses the patch itself).
 pub fn apply_creepages(contact: &WheelRailContact, points: &mut [ContactPoint], creepages: &Creepages) {
     let (wm, rm) = (&contact.wheel_material, &contact.rail_material);
     let g_mod = 2.0 / (1.0 / wm.shear_modulus() + 1.0 / rm.shear_modulus());

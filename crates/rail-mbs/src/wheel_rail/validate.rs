@@ -235,6 +235,145 @@ pub fn parse_manchester_reference(text: &str, file: &str) -> Result<Vec<Manchest
     Ok(cases)
 }
 
+/// CONTACT's contact patch of one reference case, read off its "FORM OF THE CONTACT"
+/// map (one character per element of the 0.2 mm × 0.2 mm grid of the benchmark input;
+/// `*` adhesion, `S` slip).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ManchesterPatch {
+    /// Lateral extent (along the surface), mm: rows holding contact × 0.2 mm (±0.2 mm).
+    pub lateral_extent: f64,
+    /// Longest row (rolling direction), mm: its contact elements × 0.2 mm.
+    pub length: f64,
+    /// Area, mm²: contact elements × 0.04 mm² (equals CONTACT's NCON × DX × DS).
+    pub area: f64,
+}
+
+/// Element size of the benchmark's CONTACT grid (DX = DS), mm.
+pub const MANCHESTER_GRID_MM: f64 = 0.2;
+
+/// Parses the first patch map of each case of `mbench_a22_left.ref_out`
+/// ([`ManchesterPatch`]).
+pub fn parse_manchester_patches(text: &str, file: &str) -> Result<Vec<ManchesterPatch>, ValidationError> {
+    let lines: Vec<&str> = text.lines().collect();
+    let mut out = Vec::new();
+    let mut i = 0;
+    let mut in_case = false;
+    while i < lines.len() {
+        let l = lines[i].trim();
+        if l.starts_with("Case ") {
+            in_case = true;
+        } else if in_case && l.starts_with("FORM OF THE CONTACT") {
+            let (mut rows, mut cells, mut longest) = (0usize, 0usize, 0usize);
+            i += 1;
+            while let Some(row) = lines.get(i) {
+                let mut tok = row.split_whitespace();
+                let is_row = tok.next().is_some_and(|t| t.parse::<usize>().is_ok())
+                    && row.split_whitespace().nth(1).is_some_and(|t| matches!(t, "o" | "." | "*" | "S"));
+                if !is_row {
+                    break;
+                }
+                let n = tok.filter(|t| matches!(*t, "*" | "S")).count();
+                if n > 0 {
+                    rows += 1;
+                    cells += n;
+                    longest = longest.max(n);
+                }
+                i += 1;
+            }
+            if rows == 0 {
+                return Err(ValidationError::BadData {
+                    file: file.to_string(),
+                    message: format!("line {}: empty contact map", i + 1),
+                });
+            }
+            let h = MANCHESTER_GRID_MM;
+            out.push(ManchesterPatch {
+                lateral_extent: rows as f64 * h,
+                length: longest as f64 * h,
+                area: cells as f64 * h * h,
+            });
+            in_case = false;
+            continue;
+        }
+        i += 1;
+    }
+    if out.len() != 21 {
+        return Err(ValidationError::BadData {
+            file: file.to_string(),
+            message: format!("expected 21 contact maps, found {}", out.len()),
+        });
+    }
+    Ok(out)
+}
+
+/// Our solution of one Manchester case for a patch model (CONTACT's conventions and units:
+/// mm, N, forces on the rail): see [`manchester_patch_case`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct PatchCase {
+    /// Loaded contact points (patches).
+    pub points: usize,
+    /// Lateral extent of the patch(es) along the most loaded point's `e2`, mm (Hertz: `2b`;
+    /// several points: the extent of their union).
+    pub lateral_extent: f64,
+    /// Total patch area, mm².
+    pub area: f64,
+    /// Lateral position of the contact reference point in CONTACT's track frame
+    /// (`YCP(TR)`, y to the right), mm; the normal-force-weighted mean over the points.
+    pub ycp: f64,
+    /// Total normal force, N.
+    pub fn_: f64,
+    /// Total longitudinal creep force on the rail (`FX`), N.
+    pub fx: f64,
+    /// Total lateral creep force on the rail in the contact plane (`FS`), N.
+    pub fs: f64,
+    /// The wheel pose at the solved height.
+    pub pose: WheelPose,
+}
+
+/// Solves case `c` with `contact` (its patch and creep models as set) at CONTACT's total
+/// vertical force and reads off [`PatchCase`].
+pub fn manchester_patch_case(
+    contact: &mut WheelRailContact,
+    c: &ManchesterReference,
+) -> Result<PatchCase, ValidationError> {
+    let state = WheelState {
+        lateral_shift: -c.y_ws / 1000.0,
+        yaw: -c.yaw,
+        roll: c.roll,
+        speed: c.vx / 1000.0,
+        axle_rate: Some(-c.vpitch),
+        ..Default::default()
+    };
+    let loaded = solve_vertical(contact, &state, VerticalTarget::Load(c.fz_total))?;
+    let pts = &loaded.points;
+    let main = pts.iter().max_by(|a, b| a.normal_force.total_cmp(&b.normal_force)).ok_or_else(|| {
+        ValidationError::Contact(ContactError::InvalidInput(format!("no loaded contact point at y_ws = {} mm", c.y_ws)))
+    })?;
+    let (origin, e2) = (main.point(), main.geometry.e2);
+    let (mut lo, mut hi, mut area) = (f64::INFINITY, f64::NEG_INFINITY, 0.0);
+    for p in pts {
+        let t = (p.point() - origin).dot(&e2);
+        let (l, h, a) = match &p.patch {
+            Some(s) => (s.lateral_extent.0, s.lateral_extent.1, s.area),
+            None => (-p.semi_axes.1, p.semi_axes.1, std::f64::consts::PI * p.semi_axes.0 * p.semi_axes.1),
+        };
+        lo = lo.min(t + l);
+        hi = hi.max(t + h);
+        area += a;
+    }
+    let fn_: f64 = pts.iter().map(|p| p.normal_force).sum();
+    Ok(PatchCase {
+        points: pts.len(),
+        lateral_extent: (hi - lo) * 1e3,
+        area: area * 1e6,
+        ycp: -pts.iter().map(|p| p.normal_force * p.reference_point().y).sum::<f64>() / fn_ * 1e3,
+        fn_,
+        fx: -pts.iter().map(|p| p.creep.longitudinal).sum::<f64>(),
+        fs: pts.iter().map(|p| p.creep.lateral).sum(),
+        pose: loaded.pose,
+    })
+}
+
 /// The left-wheel contact pair: rail file with its gauge point 14 mm below the crown
 /// at 717.5 mm from the centreline (offset found on the full profile, then the near-vertical
 /// canted side faces trimmed), S1002 wheel file with r0 = 460 mm and its profile origin
