@@ -615,3 +615,39 @@ def test_the_scene_reference_is_the_schema_table():
         for name, fields in sections.items():
             for key in fields:
                 assert f"| `{key}` |" in text, (kind, name, key)
+
+
+def test_track_friction_reaches_the_runs_and_bad_tables_name_the_field():
+    """``[track.friction]``: a lubricated gauge face preset (defaults filled in) or a profile table,
+    each with an optional along-track factor, goes to every run kind as ``friction_map``, reads back
+    from to_dict, and bad input names the dotted field; the run uses it (the binding builds the map
+    on the car's rail profile: a preset whose gauge face lies outside the profile is refused)."""
+    doc = _set_dotted(BASE, "track.friction", {"preset": "lubricated_gauge_face", "mu_gauge": 0.05})
+    sc = scene.load_scene(doc)
+    want = {"preset": "lubricated_gauge_face", "mu_top": 0.3, "mu_gauge": 0.05, "depth": 0.002, "width": 0.005}
+    assert sc.friction_map == want and sc.run_kwargs()["friction_map"] == want
+    assert scene.load_scene(sc.to_dict()).friction_map == want
+    assert scene.load_scene(BASE).run_kwargs()["friction_map"] is None
+    table = {"profile": [[-0.03, 0.1], [-0.02, 0.35]], "along_track": [[100.0, 1.0], [120.0, 0.5]]}
+    assert scene.load_scene(_set_dotted(BASE, "track.friction", table)).friction_map == table
+    for bad, message in (
+        ({"preset": "lubricated_gauge_face", "profile": [[0.0, 0.3]]}, r"exactly one of `track.friction.preset`"),
+        ({"profile": [[0.0, 0.3]], "mu_top": 0.4}, r"`track.friction.mu_top`"),
+        ({"preset": "lubricated_gauge_face", "mu_gauge": 1.5}, r"`track.friction.mu_gauge` = 1.5"),
+        ({"profile": [[0.0, 0.3], [0.0, 0.4]]}, r"`track.friction.profile\[1\]\[0\]`"),
+        ({"profile": [[0.0, 1.2]]}, r"`track.friction.profile\[0\]\[1\]`"),
+        ({"profile": [[0.0, 0.3]], "along_track": [[5.0, 11.0]]}, r"`track.friction.along_track\[0\]\[1\]`"),
+        ({"preset": "dry"}, r"`track.friction.preset`"),
+    ):
+        with pytest.raises(ValueError, match=message):
+            scene.load_scene(_set_dotted(BASE, "track.friction", bad))
+    # through the binding: a short run with the map, and its own checks
+    kw = {**scene.load_scene(doc).run_kwargs(), "t_end": 0.05}
+    res = railslosh.vehicle.run(sc.track_rows, **kw)
+    assert res["t"][-1] == pytest.approx(0.05)
+    with pytest.raises(ValueError, match=r"friction_map"):
+        railslosh.vehicle.run(
+            sc.track_rows, **{**kw, "friction_map": {"preset": "lubricated_gauge_face", "depth": 0.5}}
+        )
+    with pytest.raises(ValueError, match=r"friction_map"):
+        railslosh.vehicle.run(sc.track_rows, **{**kw, "friction_map": {"mu": 0.3}})

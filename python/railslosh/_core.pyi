@@ -352,6 +352,7 @@ def run_train(
     car: dict[str, float] | None = None,
     progress: _Progress | None = None,
     stream: str | None = None,
+    friction_map: dict[str, Any] | None = None,
 ) -> dict[str, Any]: ...
 def design_brake_torque(
     mass: float, v0: float = ..., v1: float = ..., duration: float = 10.0
@@ -384,6 +385,7 @@ def run_fluid_train(
     stream: str | None = None,
     wall_damping_ratio: float = ...,
     wall_adhesion: float = 0.0,
+    friction_map: dict[str, Any] | None = None,
 ) -> dict[str, Any]: ...
 def run_equivalent_train(
     track: list[list[float]],
@@ -412,6 +414,7 @@ def run_equivalent_train(
     car: dict[str, float] | None = None,
     progress: _Progress | None = None,
     stream: str | None = None,
+    friction_map: dict[str, Any] | None = None,
 ) -> dict[str, Any]: ...
 def equivalent_model(
     fill: float = 0.5,

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numbers
 import os
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -141,6 +141,7 @@ def run(
     car: dict[str, float] | None = None,
     progress: ProgressArg = None,
     stream: str | os.PathLike[str] | None = None,
+    friction_map: Mapping[str, Any] | None = None,
 ) -> dict[str, Any]:
     """Run ``cars`` coupled tank cars on ``track`` and return arrays of wheel loads ``Q``
     (``wheel_vertical``), lateral wheel forces ``Y``, ``l_over_v``, the wheel ``unloading`` ratio
@@ -166,6 +167,16 @@ def run(
     under the train at t = 0, up to :data:`railslosh.irregularity.CLEARANCE` ahead of the leading
     wheelset (:func:`wheelset_stations`), else ``ValueError``. The result keeps it as
     ``"irregularity"`` (its ``spec`` and samples go into the results' attributes and variables).
+
+    ``friction_map`` sets the wheel/rail friction over the rail profile and along the track
+    (``rail_mbs::wheel_rail::FrictionMap``; default ``None``: ``car["friction"]`` everywhere): either
+    ``{"preset": "lubricated_gauge_face", "mu_top": 0.3, "mu_gauge": 0.1, "depth": 0.002, "width":
+    0.005}`` (``mu_gauge`` on the gauge face down from ``depth`` m below the rail top, blending to
+    ``mu_top`` over ``width`` m; the values shown are the defaults) or ``{"profile": [(v, mu), ...]}``
+    (μ over the rail profile's lateral coordinate v, m, as :func:`railslosh.rail.contact`), each with
+    an optional ``"along_track": [(s, factor), ...]`` (a factor on μ over the distance s, m). Every
+    contact patch takes the μ of its own place. The same in :func:`run_fluid` and
+    :func:`run_equivalent`.
 
     Raises ``ValueError`` naming a bad field, and :class:`railslosh.slosh.SimulationError` (with
     ``.results`` up to the failure) when the run stops early.
@@ -197,6 +208,7 @@ def run(
                 car=car,
                 progress=on_progress,
                 stream=None if stream is None else os.fspath(stream),
+                friction_map=None if friction_map is None else dict(friction_map),
             )
         )
     res["load_filter"] = load_filter
@@ -239,6 +251,7 @@ def run_fluid(
     car: dict[str, float] | None = None,
     progress: ProgressArg = None,
     stream: str | os.PathLike[str] | None = None,
+    friction_map: Mapping[str, Any] | None = None,
     wall_damping_ratio: float = WALL_DAMPING_RATIO,
     wall_adhesion: float = 0.0,
 ) -> dict[str, Any]:
@@ -293,6 +306,7 @@ def run_fluid(
                 car=car,
                 progress=on_progress,
                 stream=None if stream is None else os.fspath(stream),
+                friction_map=None if friction_map is None else dict(friction_map),
                 wall_damping_ratio=wall_damping_ratio,
                 wall_adhesion=wall_adhesion,
             )
@@ -362,6 +376,7 @@ def run_equivalent(
     car: dict[str, float] | None = None,
     progress: ProgressArg = None,
     stream: str | os.PathLike[str] | None = None,
+    friction_map: Mapping[str, Any] | None = None,
 ) -> dict[str, Any]:
     """Run tank cars whose liquid is its equivalent mechanical model: per compartment one slosh mass
     on a spring (``slosh_axis = "longitudinal"``, braking) or one pendulum hinged on the tank axis
@@ -405,6 +420,7 @@ def run_equivalent(
                 car=car,
                 progress=on_progress,
                 stream=None if stream is None else os.fspath(stream),
+                friction_map=None if friction_map is None else dict(friction_map),
             )
         )
     res["load_filter"] = load_filter

@@ -85,6 +85,66 @@ fn car_params(overrides: Option<&Bound<'_, PyDict>>, wheel_profile: &str) -> PyR
     Ok(p)
 }
 
+/// The wheel/rail friction map of a run (`friction_map=` of the run functions) on the car's
+/// rail profile: `None`, or a dict with either `profile` = `[(v, mu), ...]` (μ over the rail
+/// profile's lateral coordinate, m) or `preset = "lubricated_gauge_face"` with `mu_top`,
+/// `mu_gauge`, `depth` (m below the rail top), `width` (m) (`FrictionMap::lubricated_gauge_face`),
+/// and optionally `along_track` = `[(s, factor), ...]` (a factor on μ over the distance s, m).
+fn friction_map_of(
+    spec: Option<&Bound<'_, PyDict>>,
+    rail: &rail_mbs::profile::Profile,
+) -> PyResult<Option<Arc<rail_mbs::wheel_rail::FrictionMap>>> {
+    use rail_mbs::wheel_rail::FrictionMap;
+    let Some(d) = spec else { return Ok(None) };
+    let err = |e: rail_mbs::wheel_rail::ContactError| crate::to_py(invalid("friction_map", e, "a valid friction map"));
+    const KEYS: [&str; 7] = ["preset", "profile", "mu_top", "mu_gauge", "depth", "width", "along_track"];
+    for k in d.keys() {
+        let k: String = k.extract()?;
+        if !KEYS.contains(&k.as_str()) {
+            return Err(crate::to_py(invalid("friction_map", &k, &format!("keys among {KEYS:?}"))));
+        }
+    }
+    let num = |k: &str, default: f64| -> PyResult<f64> {
+        match d.get_item(k)? {
+            None => Ok(default),
+            Some(v) => v.extract().map_err(|_| crate::to_py(invalid(&format!("friction_map.{k}"), v, "a number"))),
+        }
+    };
+    let table = |k: &str| -> PyResult<Option<Vec<(f64, f64)>>> {
+        match d.get_item(k)? {
+            None => Ok(None),
+            Some(v) => v.extract().map(Some).map_err(|_| {
+                crate::to_py(invalid(&format!("friction_map.{k}"), v, "a list of (position, value) pairs"))
+            }),
+        }
+    };
+    let preset: Option<String> = d.get_item("preset")?.map(|v| v.extract()).transpose()?;
+    let mut map = match (preset.as_deref(), table("profile")?) {
+        (Some("lubricated_gauge_face"), None) => FrictionMap::lubricated_gauge_face(
+            rail,
+            num("mu_top", 0.3)?,
+            num("mu_gauge", 0.1)?,
+            num("depth", 0.002)?,
+            num("width", 0.005)?,
+        )
+        .map_err(err)?,
+        (None, Some(profile)) => FrictionMap { profile, along_track: Vec::new() },
+        (Some(p), None) => return Err(crate::to_py(invalid("friction_map.preset", p, "'lubricated_gauge_face'"))),
+        _ => {
+            return Err(crate::to_py(invalid(
+                "friction_map",
+                "{...}",
+                "either preset = 'lubricated_gauge_face' or a profile table, one of them",
+            )));
+        }
+    };
+    if let Some(t) = table("along_track")? {
+        map.along_track = t;
+    }
+    map.validate().map_err(err)?;
+    Ok(Some(Arc::new(map)))
+}
+
 /// Arc length (m) of every wheelset at t = 0, front to rear over `cars` cars whose front tank
 /// centre is at `station`: read off the train `rail_mbs::vehicle::build_train` builds (on a
 /// straight track from the origin, where s is the global x), so it is that builder's placement.
@@ -218,7 +278,7 @@ fn brake_of(times: Option<Vec<f64>>, torques: Option<Vec<f64>>, scope: &str) -> 
     track, *, irregularity=None, cars=1, station=50.0, speed=0.0, t_end=1.0, step=1e-3, record_every=0.01, load_filter="hat_mean",
     drive_speed=None, brake_times=None, brake_torques=None, brake_scope="all",
     lading_mass=0.0, lading_height=0.0, wheel_profile="s1002", wheelset_lateral_offset=0.0,
-    coupler_stiffness=None, coupler_damping=None, car=None, progress=None, stream=None
+    coupler_stiffness=None, coupler_damping=None, car=None, progress=None, stream=None, friction_map=None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn run_train<'py>(
@@ -245,8 +305,10 @@ pub fn run_train<'py>(
     car: Option<&Bound<'py, PyDict>>,
     progress: Option<Py<PyAny>>,
     stream: Option<std::path::PathBuf>,
+    friction_map: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let mut params = car_params(car, wheel_profile)?;
+    params.contact.friction_map = friction_map_of(friction_map, &params.contact.rail_profile)?;
     if lading_mass != 0.0 {
         params.lading = Some((lading_mass, lading_height));
     }
@@ -369,7 +431,8 @@ pub fn design_brake_torque(mass: f64, v0: f64, v1: f64, duration: f64) -> PyResu
     track, *, irregularity=None, cars=1, station=300.0, speed=0.0, t_end=1.0, step=4e-3, record_every=0.02, load_filter="hat_mean", snapshot_every=0.0,
     drive_speed=None, brake_times=None, brake_torques=None, brake_scope="all", brake_factors=None,
     oil="light", fluid=None, counts=(6, 4, 2), fill=0.5, bulkheads=None, wheel_profile="s1002", car=None,
-    progress=None, stream=None, wall_damping_ratio=ancf_core::contact::WALL_DAMPING_RATIO, wall_adhesion=0.0
+    progress=None, stream=None, wall_damping_ratio=ancf_core::contact::WALL_DAMPING_RATIO, wall_adhesion=0.0,
+    friction_map=None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn run_fluid_train<'py>(
@@ -400,8 +463,10 @@ pub fn run_fluid_train<'py>(
     stream: Option<std::path::PathBuf>,
     wall_damping_ratio: f64,
     wall_adhesion: f64,
+    friction_map: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let params = car_params(car, wheel_profile)?;
+    let mut params = car_params(car, wheel_profile)?;
+    params.contact.friction_map = friction_map_of(friction_map, &params.contact.rail_profile)?;
     let brake = brake_of(brake_times, brake_torques, brake_scope)?;
     if !(fill > 0.05 && fill < 0.95) {
         return Err(crate::to_py(invalid("fill", fill, "(0.05, 0.95)")));
@@ -568,7 +633,8 @@ fn equivalent_record_dict<'py>(py: Python<'py>, r: &EquivalentTrainRecord) -> Py
     track, *, irregularity=None, cars=1, station=50.0, speed=0.0, t_end=1.0, step=1e-3, record_every=0.01, load_filter="hat_mean",
     drive_speed=None, brake_times=None, brake_torques=None, brake_scope="all", brake_factors=None,
     oil="light", fluid=None, fill=0.5, bulkheads=None, slosh_axis="longitudinal",
-    lading_mass=0.0, lading_height=0.0, wheel_profile="s1002", car=None, progress=None, stream=None
+    lading_mass=0.0, lading_height=0.0, wheel_profile="s1002", car=None, progress=None, stream=None,
+    friction_map=None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn run_equivalent_train<'py>(
@@ -598,8 +664,10 @@ pub fn run_equivalent_train<'py>(
     car: Option<&Bound<'py, PyDict>>,
     progress: Option<Py<PyAny>>,
     stream: Option<std::path::PathBuf>,
+    friction_map: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let mut params = car_params(car, wheel_profile)?;
+    params.contact.friction_map = friction_map_of(friction_map, &params.contact.rail_profile)?;
     if lading_mass != 0.0 {
         params.lading = Some((lading_mass, lading_height));
     }

@@ -188,6 +188,28 @@ SCHEMA: dict[str, dict[str, dict[str, Field]]] = {
             ),
             "length": _num(100.0, 1e6, "m", "a length", 3000.0, 'length of preset = "tangent" (only there)'),
         },
+        "track.friction": {
+            "preset": _choice(
+                ("lubricated_gauge_face",),
+                None,
+                "friction preset over the rail profile: mu_gauge on the gauge face, mu_top on the rest of the head "
+                "(railslosh.vehicle.run, friction_map); give it or `profile`",
+            ),
+            "mu_top": _num(0.0, 1.0, "", "a friction coefficient", 0.3, "top-of-rail friction of the preset"),
+            "mu_gauge": _num(0.0, 1.0, "", "a friction coefficient", 0.1, "gauge-face friction of the preset"),
+            "depth": _num(
+                1e-4, 0.03, "m", "a depth", 0.002, "the preset's gauge face starts this far below the rail top"
+            ),
+            "width": _num(1e-4, 0.05, "m", "a width", 0.005, "the preset's blend from mu_gauge to mu_top"),
+            "profile": _value(
+                "[[v, mu], ...] (m, increasing v; 0 ≤ mu ≤ 1)",
+                "friction over the rail profile's lateral coordinate v (railslosh.rail.contact's friction_profile)",
+            ),
+            "along_track": _value(
+                "[[s, factor], ...] (m, increasing s; 0 ≤ factor ≤ 10)",
+                "a factor on mu over the distance along the track (a wet or a greased stretch); 1 outside",
+            ),
+        },
         "track.irregularities": {
             "kind": _choice(
                 IRREGULARITY_KINDS,

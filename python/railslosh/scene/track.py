@@ -1,6 +1,7 @@
 """``[track]`` of vehicle scenes: a preset, or a segment table in SI or US units, as SI rows
-``(s, curvature, superelevation, grade, cant_right, cant_left)``; and its ``[track.irregularities]``
-(:func:`irregularity_table`, :func:`irregularity_spec`; :mod:`railslosh.irregularity`)."""
+``(s, curvature, superelevation, grade, cant_right, cant_left)``; its ``[track.friction]``
+(:func:`friction_table`) and its ``[track.irregularities]`` (:func:`irregularity_table`,
+:func:`irregularity_spec`; :mod:`railslosh.irregularity`)."""
 
 from __future__ import annotations
 
@@ -78,7 +79,7 @@ def us_to_si(us_rows: list[list[float]]) -> list[list[float]]:
 def track(doc: Mapping[str, Any]) -> tuple[list[list[float]], str]:
     """The SI rows of ``[track]`` and where they came from (``"preset:table1"``, ``"preset:tangent"``,
     ``"rows"`` or ``"us_rows"``)."""
-    sec = Section("vehicle", "track", doc, extra=("irregularities",))
+    sec = Section("vehicle", "track", doc, extra=("irregularities", "friction"))
     given = [k for k in ("preset", "rows", "us_rows") if k in sec]
     if len(given) != 1:
         raise invalid("track", sorted(sec.values), "exactly one of `track.preset`, `track.rows`, `track.us_rows`")
@@ -94,6 +95,49 @@ def track(doc: Mapping[str, Any]) -> tuple[list[list[float]], str]:
     if kind == "rows":
         return rows(sec.values["rows"], "track.rows", SI_COLUMNS), "rows"
     return us_to_si(rows(sec.values["us_rows"], "track.us_rows", US_COLUMNS)), "us_rows"
+
+
+# --- [track.friction] ----------------------------------------------------------------------------------
+
+FRICTION = "track.friction"
+
+
+def friction_table(doc: Mapping[str, Any]) -> dict[str, Any] | None:
+    """The ``[track.friction]`` table of a vehicle scene, checked: the ``friction_map`` of
+    :func:`railslosh.vehicle.run` (a ``preset`` with its keys, or a ``profile`` table, and an optional
+    ``along_track`` table); ``None`` without one (``car.friction`` everywhere)."""
+    tr = doc.get("track")
+    if not isinstance(tr, Mapping) or "friction" not in tr:
+        return None
+    sec = Section("vehicle", FRICTION, doc)
+    if ("preset" in sec) == ("profile" in sec):
+        raise invalid(FRICTION, sorted(sec.values), "exactly one of `track.friction.preset`, `track.friction.profile`")
+    out: dict[str, Any] = {}
+    if "preset" in sec:
+        out["preset"] = sec.get("preset")
+        for k in ("mu_top", "mu_gauge", "depth", "width"):
+            out[k] = sec.get(k)
+    else:
+        sec.only_with(["mu_top", "mu_gauge", "depth", "width"], 'with preset = "lubricated_gauge_face"')
+    for k, hi in (("profile", 1.0), ("along_track", 10.0)):
+        if k in sec:
+            out[k] = _pairs(sec.values[k], f"{FRICTION}.{k}", hi)
+    return out
+
+
+def _pairs(v: Any, field: str, hi: float) -> list[list[float]]:
+    """A ``[[position, value], ...]`` table: finite, strictly increasing positions, values in [0, hi]."""
+    if not isinstance(v, list | tuple) or not v:
+        raise invalid(field, v, "a non-empty list of [position, value] pairs")
+    value = Limit(0.0, hi, noun="a value")
+    out: list[list[float]] = []
+    for i, p in enumerate(v):
+        if not isinstance(p, list | tuple) or len(p) != 2:
+            raise invalid(f"{field}[{i}]", p, "a [position, value] pair of numbers")
+        x = Limit(-1e9, 1e9, "m", "a position").check(p[0], f"{field}[{i}][0]")
+        out.append([x, value.check(p[1], f"{field}[{i}][1]")])
+    increasing([r[0] for r in out], lambda i: f"{field}[{i}][0]")
+    return out
 
 
 # --- [track.irregularities] ----------------------------------------------------------------------------

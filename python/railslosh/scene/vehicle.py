@@ -18,7 +18,7 @@ from railslosh.limits import Limit, invalid, missing
 from railslosh.scene.common import Outputs, meta, settle_time, vehicle_outputs
 from railslosh.scene.fluid import FluidSpec, vehicle_fluid
 from railslosh.scene.schema import Section, increasing, number_list, scoped, table, unknown_sections
-from railslosh.scene.track import irregularity_spec, irregularity_table, track
+from railslosh.scene.track import friction_table, irregularity_spec, irregularity_table, track
 
 _BRAKE_TIME = Limit(0.0, 1e4, "s", "a time")
 _BRAKE_TORQUE = Limit(0.0, 1e5, "N m", "a torque")
@@ -87,6 +87,9 @@ class Scene:
     irregularity: Mapping[str, Any] | None = None
     """``[track.irregularities]`` as given, checked (SI units; a scene file's relative ``file`` made
     absolute); ``None`` = perfect track. :meth:`irregularity_spec` fills in the defaults for this train."""
+    friction_map: Mapping[str, Any] | None = None
+    """``[track.friction]``, checked (the ``friction_map`` of :func:`railslosh.vehicle.run`); ``None`` =
+    ``car.friction`` everywhere."""
 
     @property
     def kind(self) -> str:
@@ -143,6 +146,7 @@ class Scene:
             "coupler_damping": self.coupler_damping,
             "car": dict(self.car) or None,
             "irregularity": self.track_irregularity(),
+            "friction_map": None if self.friction_map is None else dict(self.friction_map),
         }
 
     def fluid_kwargs(self) -> dict[str, Any]:
@@ -220,6 +224,10 @@ def _to_dict(sc: Scene) -> dict[str, Any]:
     if sc.coupler_damping is not None:
         train["coupler_damping"] = sc.coupler_damping
     d: dict[str, Any] = {"track": {"rows": [list(r) for r in sc.track_rows]}, "train": train}
+    if sc.friction_map is not None:
+        d["track"]["friction"] = {
+            k: [list(p) for p in v] if isinstance(v, list) else v for k, v in sc.friction_map.items()
+        }
     if sc.irregularity is not None:
         d["track"]["irregularities"] = {
             k: [dict(x) for x in v] if k == "defects" else (list(v) if isinstance(v, list | tuple) else v)
@@ -401,4 +409,5 @@ def scene_from_dict(data: Mapping[str, Any]) -> Scene:
         brake_design=br["design"],
         outputs=outputs,
         irregularity=irregular,
+        friction_map=friction_table(data),
     )

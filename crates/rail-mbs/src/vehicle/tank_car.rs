@@ -53,6 +53,10 @@ pub struct ContactParams {
     pub straight_rail_cant: f64,
     /// Friction coefficient. Default 0.3.
     pub friction: f64,
+    /// Friction over the rail profile and along the track (a lubricated gauge face, a wet
+    /// stretch: [`crate::wheel_rail::FrictionMap`]); `None` (the default): `friction`
+    /// everywhere.
+    pub friction_map: Option<Arc<crate::wheel_rail::FrictionMap>>,
     /// Hunt–Crossley normal damping `d`, s/m. Default 50 s/m (dimensionless `d·δ̇`
     /// ≈ 0.05 at 1 mm/s).
     pub damping: f64,
@@ -76,6 +80,7 @@ impl ContactParams {
             gauge_depth: 0.014,
             straight_rail_cant: 1.0 / 40.0,
             friction: 0.3,
+            friction_map: None,
             damping: 50.0,
             scan_points: 200,
             always_scan: true,
@@ -406,6 +411,7 @@ fn contact_pair(p: &TankCarParams, track: &Arc<Track>, side: Side) -> Result<Whe
         RailGeometry { profile: c.rail_profile.clone(), side, profile_offset: offset, vertical_offset: 0.0, path },
     );
     w.friction = c.friction;
+    w.friction_map = c.friction_map.clone();
     w.damping = c.damping;
     w.settings.scan_points = c.scan_points;
     w.settings.always_scan = c.always_scan;
