@@ -27,9 +27,11 @@ pub mod element;
 pub mod error;
 pub mod mesh;
 pub mod quadrature;
+pub mod rng;
 pub mod shape;
 pub mod simd;
 pub mod tank;
+pub mod testing;
 pub mod validate;
 
 pub use body::FluidBody;

@@ -12,7 +12,9 @@ use crate::constitutive::{Fluid, M3, Rheology};
 use crate::element::{ElementRef, QuadratureOptions, ShapeTables, box_element};
 use crate::error::Result;
 use crate::mesh::{CylinderTankSpec, EllipticCylinderSpec, box_mesh, cylinder_tank, elliptic_cylinder};
+use crate::rng::Rng;
 use crate::shape::{N_COORDS, N_SHAPE};
+use crate::testing::{jacobian_fd_error, sample_fluids, sample_label};
 
 /// One validation check.
 #[derive(Debug, Clone, PartialEq)]
@@ -89,51 +91,6 @@ pub fn run_case(name: &str, quick: bool) -> Result<Vec<Record>> {
         "rigid-motion-invariance" => rigid_motion_invariance(if quick { 3 } else { 10 }),
         other => Err(crate::error::invalid("case", other, &format!("one of {CASES:?}"))),
     }
-}
-
-/// Small deterministic pseudo-random generator (SplitMix64), uniform in [-1, 1).
-#[derive(Debug, Clone)]
-pub struct Rng(u64);
-
-impl Rng {
-    /// Seeded generator.
-    pub fn new(seed: u64) -> Self {
-        Self(seed)
-    }
-    /// Next number in [-1, 1).
-    pub fn uniform(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E3779B97F4A7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58476D1CE4E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D049BB133111EB);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-    }
-    /// A random unit-ish vector scaled by `s`.
-    pub fn vec3(&mut self, s: f64) -> [f64; 3] {
-        [s * self.uniform(), s * self.uniform(), s * self.uniform()]
-    }
-}
-
-/// The five rheologies with representative parameters, and a penalty; the sixth is the
-/// Newtonian one with the shear stabilization ([`Fluid::shear_stabilization`]).
-pub fn sample_fluids() -> Vec<Fluid> {
-    let mk = |rheology| Fluid { bulk_damping: 20.0, ..Fluid::new(900.0, rheology, 2.0e5).expect("valid") };
-    let newtonian = mk(Rheology::Newtonian { viscosity: 0.8 });
-    vec![
-        newtonian,
-        mk(Rheology::Bingham { viscosity: 0.5, yield_stress: 3.0 }),
-        mk(Rheology::HerschelBulkley { consistency: 0.7, power_index: 0.6, yield_stress: 2.0 }),
-        mk(Rheology::Oldroyd { viscosity: 0.5, yield_stress: 40.0, elastic_modulus: Some(800.0) }),
-        mk(Rheology::Casson { viscosity: 0.4, yield_stress: 2.5 }),
-        Fluid { shear_stabilization: 300.0, ..newtonian },
-    ]
-}
-
-/// The name of a sample fluid in records: its law, and "+ shear stabilization" when it has one.
-pub fn sample_label(fluid: &Fluid) -> String {
-    let name = fluid.rheology.name();
-    if fluid.shear_stabilization > 0.0 { format!("{name} + shear stabilization") } else { name.to_string() }
 }
 
 fn element_mass() -> Result<Vec<Record>> {
@@ -236,42 +193,6 @@ fn random_state(rng: &mut Rng, e0: &[[f64; 3]; N_SHAPE], amp: f64, vamp: f64) ->
         }
     }
     (e, v)
-}
-
-/// Max relative finite-difference error of K = ∂f/∂e and C = ∂f/∂ė of one element.
-pub fn jacobian_fd_error(
-    fluid: &Fluid,
-    el: &ElementRef,
-    tables: &ShapeTables,
-    e: &[f64],
-    v: &[f64],
-) -> Result<(f64, f64)> {
-    let cpt = crate::element::to_compact;
-    let mut f0 = [0.0; N_COORDS];
-    let mut k = vec![0.0; N_COORDS * N_COORDS];
-    let mut cm = vec![0.0; N_COORDS * N_COORDS];
-    el.internal_force(0, fluid, tables, &cpt(e), &cpt(v), &mut f0, Some((&mut k, &mut cm)))?;
-    let mut errs = [0.0f64; 2];
-    for (w, jac) in [&k, &cm].into_iter().enumerate() {
-        let scale = jac.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        let mut worst = 0.0f64;
-        for d in 0..N_COORDS {
-            let h = 1e-6;
-            let (mut xp, mut xm) = if w == 0 { (e.to_vec(), e.to_vec()) } else { (v.to_vec(), v.to_vec()) };
-            xp[d] += h;
-            xm[d] -= h;
-            let (mut fp, mut fm) = ([0.0; N_COORDS], [0.0; N_COORDS]);
-            let (ep, em, vp, vm) = if w == 0 { (&xp[..], &xm[..], v, v) } else { (e, e, &xp[..], &xm[..]) };
-            el.internal_force(0, fluid, tables, &cpt(ep), &cpt(vp), &mut fp, None)?;
-            el.internal_force(0, fluid, tables, &cpt(em), &cpt(vm), &mut fm, None)?;
-            for r in 0..N_COORDS {
-                let fd = (fp[r] - fm[r]) / (2.0 * h);
-                worst = worst.max((fd - jac[r * N_COORDS + d]).abs());
-            }
-        }
-        errs[w] = worst / scale.max(1e-300);
-    }
-    Ok((errs[0], errs[1]))
 }
 
 fn element_jacobians(samples: usize) -> Result<Vec<Record>> {

@@ -5,6 +5,7 @@
 //! integrator loop) → [`SloshRecord`] (time series, recorded every step); [`modes`] gives the
 //! small-amplitude modes of a [`SloshSystem`] about a state at rest.
 
+pub mod analysis;
 pub mod linear_theory;
 pub mod modes;
 pub mod motion;

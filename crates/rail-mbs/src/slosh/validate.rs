@@ -23,6 +23,8 @@ use ancf_core::mesh::{CylinderTankSpec, FluidMesh, box_mesh, cylinder_tank, cyli
 use ancf_core::tank::{Bulkhead, TankGeometry, TankShape};
 use ancf_core::validate::Record;
 
+use super::analysis::dominant_frequency;
+use super::linear_theory::rect_tank_frequency;
 use super::{PiecewiseAcceleration, PrescribedMotion, SloshFrame, SloshRecord, SloshRun, SloshSystem, linear_modes};
 
 use ancf_core::constants::GRAVITY as G;
@@ -137,58 +139,6 @@ fn hydrostatic_cylinder(quick: bool) -> Result<Vec<Record>> {
         ),
         Record::abs(c, "centre-of-mass height / R (exact liquid centroid)", zm / r, zc / r, 0.01),
     ])
-}
-
-/// Dominant frequency of `x(t)` for t ≥ t0 in [f_lo, f_hi] Hz: the signal is resampled
-/// uniformly, detrended, Hann-windowed, and the peak of its Fourier amplitude is located on
-/// a fine frequency grid (parabolic refinement). Robust to high-frequency contact chatter.
-pub fn dominant_frequency(t: &[f64], x: &[f64], t0: f64, f_lo: f64, f_hi: f64) -> f64 {
-    let i0 = t.iter().position(|&ti| ti >= t0).unwrap_or(t.len());
-    if t.len() < i0 + 8 {
-        return f64::NAN;
-    }
-    let (ta, tb) = (t[i0], t[t.len() - 1]);
-    let n = 2048;
-    let dt = (tb - ta) / (n - 1) as f64;
-    let mut y = Vec::with_capacity(n);
-    let mut j = i0;
-    for k in 0..n {
-        let tk = ta + k as f64 * dt;
-        while j + 1 < t.len() - 1 && t[j + 1] < tk {
-            j += 1;
-        }
-        let s = ((tk - t[j]) / (t[j + 1] - t[j])).clamp(0.0, 1.0);
-        y.push(x[j] + s * (x[j + 1] - x[j]));
-    }
-    let mean = y.iter().sum::<f64>() / n as f64;
-    for (k, v) in y.iter_mut().enumerate() {
-        let w = 0.5 - 0.5 * (2.0 * std::f64::consts::PI * k as f64 / (n - 1) as f64).cos();
-        *v = (*v - mean) * w;
-    }
-    let amp = |f: f64| {
-        let (mut re, mut im) = (0.0, 0.0);
-        for (k, v) in y.iter().enumerate() {
-            let ph = 2.0 * std::f64::consts::PI * f * k as f64 * dt;
-            re += v * ph.cos();
-            im += v * ph.sin();
-        }
-        (re * re + im * im).sqrt()
-    };
-    let m = 600;
-    let grid: Vec<f64> = (0..=m).map(|i| f_lo + (f_hi - f_lo) * i as f64 / m as f64).collect();
-    let a: Vec<f64> = grid.iter().map(|&f| amp(f)).collect();
-    let ib = (1..m).max_by(|&p, &q| a[p].total_cmp(&a[q])).unwrap_or(1);
-    let (y0, y1, y2) = (a[ib - 1], a[ib], a[ib + 1]);
-    let den = y0 - 2.0 * y1 + y2;
-    let off = if den != 0.0 { 0.5 * (y0 - y2) / den } else { 0.0 };
-    grid[ib] + off * (f_hi - f_lo) / m as f64
-}
-
-/// Analytic first sloshing frequency of a rectangular tank of length `l` along the motion,
-/// depth `h`: f = √(g k tanh(k h)) / 2π, k = π / l (seed 003 appendix C §4.1).
-pub fn rect_tank_frequency(l: f64, h: f64) -> f64 {
-    let k = std::f64::consts::PI / l;
-    (G * k * (k * h).tanh()).sqrt() / (2.0 * std::f64::consts::PI)
 }
 
 fn rect_setup(counts: [usize; 3]) -> Result<(FluidMesh, Fluid, TankGeometry)> {

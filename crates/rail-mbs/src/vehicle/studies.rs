@@ -39,7 +39,8 @@ use super::fluid::{FluidCargo, FluidTrainRecord, run_fluid_train};
 use super::run::{BrakeScope, TrainScenario};
 use super::tank_car::TankCarParams;
 use crate::mbs::SpeedProfile;
-use crate::track::{FOOT, GRAVITY, Track, TrackPoint};
+use crate::track::presets::{TABLE1_BODY_END, table1};
+use crate::track::{GRAVITY, Track};
 
 pub use crate::defaults::{Oil, SETTLE, brake_torque};
 
@@ -372,29 +373,6 @@ fn bulkhead_reduction(quick: bool) -> Result<Vec<Record>> {
         ),
     ])
 }
-
-/// Seed 000 Table 1 track: (distance ft, curvature degrees, super-elevation in).
-const TABLE1_ROWS: [(f64, f64, f64); 10] = [
-    (0.0, 0.0, 0.0),
-    (100.0, 0.0, 0.0),
-    (300.0, 3.0, 3.0),
-    (600.0, 3.0, 3.0),
-    (800.0, 0.0, 0.0),
-    (1000.0, 0.0, 0.0),
-    (1200.0, -3.0, -3.0),
-    (1500.0, -3.0, -3.0),
-    (1700.0, 0.0, 0.0),
-    (2800.0, 0.0, 0.0),
-];
-
-/// Seed 000 Table 1 track (US units).
-pub fn table1() -> Result<Arc<Track>> {
-    let pts = TABLE1_ROWS.iter().map(|&(d, c, e)| TrackPoint::from_us(d, c, e, 0.0, 0.025, -0.025)).collect();
-    Track::new(pts).map(Arc::new).map_err(|e| invalid("track", e, "valid"))
-}
-
-/// End of the body (constant curvature) of the first Table 1 curve, m.
-pub const TABLE1_BODY_END: f64 = TABLE1_ROWS[3].0 * FOOT;
 
 /// Outward inertia force and in-plane gravity component of the oil (mean over the last
 /// period of the first transverse slosh mode) for one car driven at `speed` through the Table 1 curve. The run starts with the

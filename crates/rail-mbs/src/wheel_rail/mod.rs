@@ -73,6 +73,7 @@ pub mod creep;
 pub mod friction;
 pub mod hertz;
 pub mod kik_piotrowski;
+pub mod manchester;
 pub mod static_load;
 pub mod validate;
 
