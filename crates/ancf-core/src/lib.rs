@@ -32,7 +32,6 @@ pub mod shape;
 pub mod simd;
 pub mod tank;
 pub mod testing;
-pub mod validate;
 
 pub use body::FluidBody;
 pub use constitutive::{Fluid, Rheology};

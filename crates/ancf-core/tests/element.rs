@@ -9,43 +9,7 @@ use ancf_core::mesh::{CylinderTankSpec, EllipticCylinderSpec, box_mesh, cylinder
 use ancf_core::rng::Rng;
 use ancf_core::shape::{N_COORDS, N_SHAPE};
 use ancf_core::testing::sample_fluids;
-use ancf_core::validate::{CASES, run_case};
 use ancf_core::{AncfError, FluidBody};
-
-fn assert_case(name: &str) {
-    let recs = run_case(name, false).unwrap();
-    assert!(!recs.is_empty());
-    for r in &recs {
-        assert!(
-            r.passed,
-            "{}: {} measured {:e} reference {:e} tol {:e}",
-            r.case, r.quantity, r.measured, r.reference, r.tolerance
-        );
-    }
-}
-
-#[test]
-fn validation_case_element_mass() {
-    assert_case("element-mass");
-}
-
-#[test]
-fn validation_case_element_jacobians() {
-    assert_case("element-jacobians");
-}
-
-#[test]
-fn validation_case_rigid_motion_invariance() {
-    assert_case("rigid-motion-invariance");
-}
-
-#[test]
-fn unknown_case_is_an_error_listing_cases() {
-    let err = run_case("nope", true).unwrap_err().to_string();
-    for c in CASES {
-        assert!(err.contains(c), "{err}");
-    }
-}
 
 fn newtonian(mu: f64, k: f64) -> Fluid {
     Fluid::new(1000.0, Rheology::Newtonian { viscosity: mu }, k).unwrap()

@@ -11,7 +11,6 @@ pub mod modes;
 pub mod motion;
 pub mod scenario;
 pub mod system;
-pub mod validate;
 
 pub use modes::{LinearModes, linear_modes};
 pub use motion::{PiecewiseAcceleration, PrescribedMotion, TankFrameInput, TankFrameSample, TankState};

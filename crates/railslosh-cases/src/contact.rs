@@ -8,7 +8,7 @@
 //! # Data
 //!
 //! `manchester-contact-left` reads the CONTACT example files from the shared data directory
-//! ([`super::manchester`]: where it is searched, the readers, the contact pair and the
+//! ([`rail_mbs::wheel_rail::manchester`]: where it is searched, the readers, the contact pair and the
 //! frames). When the files are absent the case returns [`ValidationError::DataNotFound`]; the
 //! CLI and the Python tests report it as *skipped: data not found*, never as passed or failed.
 //!
@@ -19,21 +19,22 @@
 
 use std::path::{Path, PathBuf};
 
-use ancf_core::validate::Record;
 use nalgebra::{Matrix3, Vector3};
 use thiserror::Error;
 
-use super::manchester::{
+use rail_mbs::profile::{Profile, ProfileError, uic60_rail};
+use rail_mbs::track::Side;
+use rail_mbs::wheel_rail::manchester::{
     DATA_ENV, DataError, MANCHESTER_DIR, MANCHESTER_FILES, ManchesterReference, find_dataset, manchester_contact_pair,
     parse_manchester_reference,
 };
-use super::static_load::{VerticalTarget, WheelState, solve_vertical};
-use super::{
+use rail_mbs::wheel_rail::static_load::{VerticalTarget, WheelState, solve_vertical};
+use rail_mbs::wheel_rail::{
     ContactError, ContactGeometry, ContactPoint, CreepModel, RailGeometry, RailPath, WheelGeometry, WheelPose,
     WheelRailContact,
 };
-use crate::profile::{Profile, ProfileError, uic60_rail};
-use crate::track::Side;
+
+use crate::Record;
 
 /// Names of the contact cases.
 pub const CASES: [&str; 2] = ["manchester-contact-left", "klingel-wavelength"];

@@ -8,7 +8,7 @@
 //! | `slosh-viscous-decay` | free sloshing after a pulse decays faster from water through the light, medium and heavy crudes of seed 000 Table 2; the heavy crude settles within one period |
 //! | `bulkhead-longitudinal` | under the same braking pulse, a tank car divided into three compartments by two bulkheads has a lower peak longitudinal load than the open tank |
 //! | `tank-frame-equivalence` | the same motion given as tank-frame pseudo-forces (seed 003 eq. 7.40) and as prescribed inertial motion gives the same loads |
-//! | `slosh-linear-potential-flow` | seed 003's rectangular tank under a 0.03 g lateral pulse (linear regime): the lateral load history vs the 50-mode linear potential-flow solution ([`super::linear_theory`]), RMS difference over 0.5–4 s ≤ 10 % of its peak; first-mode frequency from zero crossings vs 1.436 Hz |
+//! | `slosh-linear-potential-flow` | seed 003's rectangular tank under a 0.03 g lateral pulse (linear regime): the lateral load history vs the 50-mode linear potential-flow solution ([`rail_mbs::slosh::linear_theory`]), RMS difference over 0.5–4 s ≤ 10 % of its peak; first-mode frequency from zero crossings vs 1.436 Hz |
 //! | `slosh-load-convergence` | the same tank under a 0.3 g lateral pulse (issue 16 §3): the peak lateral load after the pulse and f₁ from the zero crossings of the raw load change by ≤ 5 % between the two finest of three meshes and between two step sizes; on the finest mesh the raw zero-crossing frequency is within 3 % of the spectral peak (no chatter) |
 //!
 //! `quick` selects coarser meshes and shorter runs (as run in CI); the full forms are the
@@ -21,11 +21,14 @@ use ancf_core::element::QuadratureOptions;
 use ancf_core::error::{AncfError, Result};
 use ancf_core::mesh::{CylinderTankSpec, FluidMesh, box_mesh, cylinder_tank, cylinder_tank_compartments};
 use ancf_core::tank::{Bulkhead, TankGeometry, TankShape};
-use ancf_core::validate::Record;
 
-use super::analysis::dominant_frequency;
-use super::linear_theory::rect_tank_frequency;
-use super::{PiecewiseAcceleration, PrescribedMotion, SloshFrame, SloshRecord, SloshRun, SloshSystem, linear_modes};
+use rail_mbs::slosh::analysis::dominant_frequency;
+use rail_mbs::slosh::linear_theory::rect_tank_frequency;
+use rail_mbs::slosh::{
+    PiecewiseAcceleration, PrescribedMotion, SloshFrame, SloshRecord, SloshRun, SloshSystem, linear_modes,
+};
+
+use crate::Record;
 
 use ancf_core::constants::GRAVITY as G;
 
@@ -56,7 +59,7 @@ pub fn run_case(name: &str, quick: bool) -> Result<Vec<Record>> {
     }
 }
 
-pub use crate::defaults::{liquid, slosh_params};
+pub use rail_mbs::defaults::{liquid, slosh_params};
 
 #[allow(clippy::too_many_arguments)]
 fn run(
@@ -584,7 +587,7 @@ fn crossing_frequency(t: &[f64], y: &[f64]) -> f64 {
 /// The pulse: 0.03 g from 0.1 s to 0.5 s with 20 ms linear ramps (0.4 s ≈ 0.57 of the first
 /// period, which puts 97 % of the largest possible residual amplitude into mode 1). The
 /// lateral load on the tank (`force_tank` y) is compared with the 50-mode linear
-/// potential-flow solution ([`super::linear_theory::RectangularTankModes`], undamped, the
+/// potential-flow solution ([`rail_mbs::slosh::linear_theory::RectangularTankModes`], undamped, the
 /// ANCF liquid's mass) at the same times: RMS of the difference over 0.5–4 s, both on a
 /// 1 ms grid, divided by the modal solution's peak |F| over that window, ≤ 0.10.
 ///
@@ -622,7 +625,7 @@ fn slosh_linear_potential_flow(quick: bool) -> Result<Vec<Record>> {
     law.points_per_edge = 4;
     let quad = QuadratureOptions { penalty: 4, ..QuadratureOptions::default() };
     let (rec, mass) = run_with(mesh, fluid, geo, law, quad, motion, SloshFrame::Inertial, t_b, h)?;
-    let modes = super::linear_theory::RectangularTankModes::new(ly, d, mass, G, 50)?;
+    let modes = rail_mbs::slosh::linear_theory::RectangularTankModes::new(ly, d, mass, G, 50)?;
     let n_grid = ((t_b - t_a) / 1e-3).round() as usize;
     let grid: Vec<f64> = (0..=n_grid).map(|i| t_a + (t_b - t_a) * i as f64 / n_grid as f64).collect();
     let f_ref = modes.force_history(&samples, &grid)?;
@@ -752,7 +755,7 @@ fn pulse_load(counts: [usize; 3], h: f64, t_a: f64, t_b: f64) -> Result<PulseLoa
 ///   1.7–1.9 s of the 3.9 s on 2×6×3 and 2×8×4 (Newton retries at contact changes), so only the
 ///   cap of 1 ms changes much.
 ///
-/// Full form (`cargo run --release -p rail-mbs --example slosh_validate -- slosh-load-convergence`,
+/// Full form (`cargo run --release -p railslosh-cases --example slosh_validate -- slosh-load-convergence`,
 /// 399 s): raw peak 48.73 / 53.09 / 68.36 N, raw f 2.371 / 1.3850 / 1.3791 Hz (spectral 1.3857 /
 /// 1.3823 / 1.3782 Hz) on 2×4×2 / 2×6×3 / 2×8×4. Mesh: peak FAILS (22 % change), f passes
 /// (0.4 %). Steps on 2×6×3: peak passes (53.09 vs 53.45 N), raw f FAILS (1.3850 vs 1.7334 Hz:

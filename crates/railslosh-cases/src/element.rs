@@ -4,81 +4,22 @@
 //! tolerance. The cases are written once here and reused by the Rust tests, the Python
 //! tests and the CLI, so that what CI checks is exactly what users can run.
 
+// Index loops mirror the tensor index notation of the formulas (as in ancf-core).
+#![allow(clippy::needless_range_loop)]
+
 use nalgebra::{Rotation3, Vector3};
 
-use crate::FluidBody;
-use crate::body::rigid_motion;
-use crate::constitutive::{Fluid, M3, Rheology};
-use crate::element::{ElementRef, QuadratureOptions, ShapeTables, box_element};
-use crate::error::Result;
-use crate::mesh::{CylinderTankSpec, EllipticCylinderSpec, box_mesh, cylinder_tank, elliptic_cylinder};
-use crate::rng::Rng;
-use crate::shape::{N_COORDS, N_SHAPE};
-use crate::testing::{jacobian_fd_error, sample_fluids, sample_label};
+use ancf_core::FluidBody;
+use ancf_core::body::rigid_motion;
+use ancf_core::constitutive::{Fluid, M3, Rheology};
+use ancf_core::element::{ElementRef, QuadratureOptions, ShapeTables, box_element};
+use ancf_core::error::Result;
+use ancf_core::mesh::{CylinderTankSpec, EllipticCylinderSpec, box_mesh, cylinder_tank, elliptic_cylinder};
+use ancf_core::rng::Rng;
+use ancf_core::shape::{N_COORDS, N_SHAPE};
+use ancf_core::testing::{jacobian_fd_error, sample_fluids, sample_label};
 
-/// One validation check.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Record {
-    /// Case name (e.g. `element-mass`).
-    pub case: String,
-    /// What was measured.
-    pub quantity: String,
-    /// Measured value.
-    pub measured: f64,
-    /// Reference value.
-    pub reference: f64,
-    /// Allowed |measured − reference| (absolute unless the quantity says "relative").
-    pub tolerance: f64,
-    /// Whether the check passed.
-    pub passed: bool,
-}
-
-/// One line: case, quantity, measured, reference, tolerance and verdict.
-impl std::fmt::Display for Record {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "{} {}: measured {:.6} reference {:.6} tol {:.3e} -> {}",
-            self.case,
-            self.quantity,
-            self.measured,
-            self.reference,
-            self.tolerance,
-            if self.passed { "ok" } else { "FAIL" }
-        )
-    }
-}
-
-impl Record {
-    /// Check |measured − reference| ≤ tolerance.
-    pub fn abs(case: &str, quantity: impl Into<String>, measured: f64, reference: f64, tolerance: f64) -> Self {
-        let passed = (measured - reference).abs() <= tolerance && measured.is_finite();
-        Self { case: case.into(), quantity: quantity.into(), measured, reference, tolerance, passed }
-    }
-    /// Check |measured| ≤ limit.
-    pub fn at_most(case: &str, quantity: impl Into<String>, measured: f64, limit: f64) -> Self {
-        Self {
-            case: case.into(),
-            quantity: quantity.into(),
-            measured,
-            reference: 0.0,
-            tolerance: limit,
-            passed: measured.is_finite() && measured.abs() <= limit,
-        }
-    }
-    /// Check measured < limit (signed; the limit is reported as the reference, with a zero
-    /// tolerance).
-    pub fn less_than(case: &str, quantity: impl Into<String>, measured: f64, limit: f64) -> Self {
-        Self {
-            case: case.into(),
-            quantity: quantity.into(),
-            measured,
-            reference: limit,
-            tolerance: 0.0,
-            passed: measured.is_finite() && measured < limit,
-        }
-    }
-}
+use crate::Record;
 
 /// Names of the cases this module provides.
 pub const CASES: [&str; 3] = ["element-mass", "element-jacobians", "rigid-motion-invariance"];
@@ -89,7 +30,7 @@ pub fn run_case(name: &str, quick: bool) -> Result<Vec<Record>> {
         "element-mass" => element_mass(),
         "element-jacobians" => element_jacobians(if quick { 2 } else { 6 }),
         "rigid-motion-invariance" => rigid_motion_invariance(if quick { 3 } else { 10 }),
-        other => Err(crate::error::invalid("case", other, &format!("one of {CASES:?}"))),
+        other => Err(ancf_core::error::invalid("case", other, &format!("one of {CASES:?}"))),
     }
 }
 
@@ -115,7 +56,7 @@ fn element_mass() -> Result<Vec<Record>> {
     let mmat = faer::Mat::from_fn(N_SHAPE, N_SHAPE, |i, j| m[i * N_SHAPE + j]);
     let eig = mmat
         .self_adjoint_eigenvalues(faer::Side::Lower)
-        .map_err(|_| crate::error::AncfError::NonFinite { what: "mass eigenvalues".into(), element: 0 })?;
+        .map_err(|_| ancf_core::error::AncfError::NonFinite { what: "mass eigenvalues".into(), element: 0 })?;
     let lmin = eig.iter().copied().fold(f64::INFINITY, f64::min);
     out.push(Record {
         case: c.into(),
@@ -125,7 +66,7 @@ fn element_mass() -> Result<Vec<Record>> {
         tolerance: 0.0,
         passed: lmin > 0.0,
     });
-    let g = crate::constants::GRAVITY;
+    let g = ancf_core::constants::GRAVITY;
     let gs = el.gravity_scale(rho, &tables);
     out.push(Record::abs(c, "gravity force, position entry (N): -rho V g / 8", -gs[0] * g, -rho * g / 8.0, 1e-8));
     out.push(Record::abs(
@@ -210,7 +151,7 @@ fn element_jacobians(samples: usize) -> Result<Vec<Record>> {
             let mut fl = fluid;
             if let Rheology::Oldroyd { viscosity, elastic_modulus, .. } = fluid.rheology {
                 // put the first viscous point inside the elastic/viscous blend band
-                let ehat = crate::element::scaled(&crate::element::to_compact(&e), &el.scale);
+                let ehat = ancf_core::element::scaled(&ancf_core::element::to_compact(&e), &el.scale);
                 let mut fhat = M3::zeros();
                 for a in 0..N_SHAPE {
                     for i in 0..3 {
@@ -221,7 +162,7 @@ fn element_jacobians(samples: usize) -> Result<Vec<Record>> {
                 }
                 let f = fhat * el.viscous[0].jinv;
                 let g = elastic_modulus.unwrap_or(0.0);
-                let se = 2.0 * g * crate::constitutive::dev(&(0.5 * (f.transpose() * f - M3::identity())));
+                let se = 2.0 * g * ancf_core::constitutive::dev(&(0.5 * (f.transpose() * f - M3::identity())));
                 let ne = (0.5 * se.component_mul(&se).sum()).sqrt();
                 fl.rheology = Rheology::Oldroyd { viscosity, yield_stress: ne * 1.01, elastic_modulus };
             }

@@ -32,17 +32,16 @@ use std::sync::Arc;
 
 use ancf_core::element::QuadratureOptions;
 use ancf_core::error::{AncfError, Result, invalid};
-use ancf_core::validate::Record;
+use rail_mbs::mbs::SpeedProfile;
+use rail_mbs::track::presets::{TABLE1_BODY_END, table1};
+use rail_mbs::track::{GRAVITY, Track};
+use rail_mbs::vehicle::equivalent::cylinder_lambda;
+use rail_mbs::vehicle::fluid::{FluidCargo, FluidTrainRecord, run_fluid_train};
+use rail_mbs::vehicle::{BrakeScope, TankCarParams, TrainScenario};
 
-use super::equivalent::cylinder_lambda;
-use super::fluid::{FluidCargo, FluidTrainRecord, run_fluid_train};
-use super::run::{BrakeScope, TrainScenario};
-use super::tank_car::TankCarParams;
-use crate::mbs::SpeedProfile;
-use crate::track::presets::{TABLE1_BODY_END, table1};
-use crate::track::{GRAVITY, Track};
+use crate::Record;
 
-pub use crate::defaults::{Oil, SETTLE, brake_torque};
+pub use rail_mbs::defaults::{Oil, SETTLE, brake_torque};
 
 /// A braking run of the studies.
 #[derive(Debug, Clone)]
@@ -69,7 +68,7 @@ pub struct BrakingCase {
     /// 0, or 4 as the shipped ECP scenes use).
     pub wall_adhesion: f64,
     /// How the coupled Newton matrix is solved ([`FluidCargo::linear_solver`]).
-    pub linear_solver: crate::integrator::LinearSolverKind,
+    pub linear_solver: rail_mbs::integrator::LinearSolverKind,
 }
 
 fn tangent() -> Result<Arc<Track>> {
@@ -85,7 +84,7 @@ fn cargo(oil: Oil, counts: [usize; 3], bulkheads: bool, p: &TankCarParams) -> Re
 }
 
 fn finish(
-    out: std::result::Result<FluidTrainRecord, Box<super::fluid::FluidTrainFailure>>,
+    out: std::result::Result<FluidTrainRecord, Box<rail_mbs::vehicle::fluid::FluidTrainFailure>>,
 ) -> Result<FluidTrainRecord> {
     out.map_err(|f| {
         AncfError::Solver(format!("{} (at t = {:.3} s)", f.error, f.record.train.t.last().copied().unwrap_or(0.0)))
@@ -214,7 +213,7 @@ fn braking(oil: Oil, cars: usize, scope: BrakeScope, bulkheads: bool, quick: boo
         rear_brake_factor: rear,
         wall_damping_ratio: ancf_core::contact::WALL_DAMPING_RATIO,
         wall_adhesion: 0.0,
-        linear_solver: crate::integrator::LinearSolverKind::Condensed,
+        linear_solver: rail_mbs::integrator::LinearSolverKind::Condensed,
     }
 }
 
@@ -494,7 +493,7 @@ fn mesh_convergence(quick: bool) -> Result<Vec<Record>> {
                     rear_brake_factor: 1.0,
                     wall_damping_ratio: ancf_core::contact::WALL_DAMPING_RATIO,
                     wall_adhesion: 0.0,
-                    linear_solver: crate::integrator::LinearSolverKind::Condensed,
+                    linear_solver: rail_mbs::integrator::LinearSolverKind::Condensed,
                 })
             }) as Job<'static, FluidTrainRecord>
         })
@@ -568,7 +567,7 @@ fn coupler_force_convergence(quick: bool) -> Result<Vec<Record>> {
             rear_brake_factor: 1.0,
             wall_damping_ratio: 1.0,
             wall_adhesion: 4.0,
-            linear_solver: crate::integrator::LinearSolverKind::Condensed,
+            linear_solver: rail_mbs::integrator::LinearSolverKind::Condensed,
         };
         for m in meshes {
             jobs.push(Box::new(move || run_braking(&case(m))));
