@@ -8,9 +8,10 @@
 //! # Data
 //!
 //! `manchester-contact-left` reads the CONTACT example files from the shared data directory
-//! ([`rail_mbs::wheel_rail::manchester`]: where it is searched, the readers, the contact pair and the
-//! frames). When the files are absent the case returns [`ValidationError::DataNotFound`]; the
-//! CLI and the Python tests report it as *skipped: data not found*, never as passed or failed.
+//! ([`rail_mbs::wheel_rail::manchester`]: where it is searched, the readers, the contact pair
+//! and the frames). When the files are absent the case returns
+//! [`ValidationError::DataNotFound`]; the CLI and the Python tests report it as *skipped: data
+//! not found*, never as passed or failed.
 //!
 //! `quick` runs the integer shifts 0, 1, …, 10 mm (11 of the 21) with the
 //! Shen–Hedrick–Elkins creep law and one cone for the Klingel case; the full forms run all 21
