@@ -1,6 +1,6 @@
 """Work–precision benchmarks of ``railslosh bench``: run time against error.
 
-Each sweep (implemented in Rust, ``rail_mbs::work_precision``) runs one case over a grid of
+Each sweep (implemented in Rust, ``railslosh_cases::work_precision``) runs one case over a grid of
 time steps, meshes, quadrature rules, Newton tolerances and linear solvers, and measures for
 every point its wall time and its errors against a converged reference run:
 

@@ -1,5 +1,5 @@
 """Validation records: the one definition of the record every ``railslosh validate`` case prints
-(Rust's ``ancf_core::validate::Record``: case, quantity, measured, reference, tolerance, passed),
+(Rust's ``railslosh_cases::Record``: case, quantity, measured, reference, tolerance, passed),
 the builders the Python cases use, and the exception of a case that cannot run."""
 
 from __future__ import annotations

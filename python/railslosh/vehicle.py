@@ -222,7 +222,7 @@ def design_brake_torque(
 ) -> tuple[list[float], list[float]]:
     """Brake torque per wheelset, ``(times, torques)``, that slows a car of total mass ``mass`` (kg,
     liquid included) from ``v0`` to ``v1`` (m/s) in ``duration`` s: ``T0 (1 - exp(-(t - 0.5)/0.5))``
-    after a 0.5 s settling time (the design of seed 000 §8.2; see ``rail_mbs::vehicle::studies``)."""
+    after a 0.5 s settling time (the design of seed 000 §8.2; see ``railslosh_cases::vehicle::studies``)."""
     return _core.design_brake_torque(mass, v0, v1, duration)
 
 

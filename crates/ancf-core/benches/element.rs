@@ -37,7 +37,7 @@ use ancf_core::FluidBody;
 use ancf_core::constitutive::{DeviatoricPath, Fluid, M3, Rheology, Tangent};
 use ancf_core::element::{QuadratureOptions, VolumetricJacobian};
 use ancf_core::mesh::box_mesh;
-use ancf_core::validate::Rng;
+use ancf_core::rng::Rng;
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(|a, b| a.partial_cmp(b).unwrap());

@@ -992,8 +992,8 @@ mod tests {
     use crate::constitutive::{Fluid, Rheology};
     use crate::element::QuadratureOptions;
     use crate::mesh::box_mesh;
+    use crate::rng::Rng;
     use crate::tank::{Bulkhead, TankShape};
-    use crate::validate::Rng;
     use nalgebra::Rotation3;
 
     /// The liquid column of depth H (mass ρH per unit area) resting on the wall spring,

@@ -27,10 +27,11 @@ pub mod element;
 pub mod error;
 pub mod mesh;
 pub mod quadrature;
+pub mod rng;
 pub mod shape;
 pub mod simd;
 pub mod tank;
-pub mod validate;
+pub mod testing;
 
 pub use body::FluidBody;
 pub use constitutive::{Fluid, Rheology};

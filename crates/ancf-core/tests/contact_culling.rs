@@ -16,8 +16,8 @@ use ancf_core::mesh::{
     CylinderTankSpec, EllipticCylinderSpec, FluidMesh, box_mesh, cylinder_tank, cylinder_tank_compartments,
     elliptic_cylinder,
 };
+use ancf_core::rng::Rng;
 use ancf_core::tank::{Bulkhead, TankGeometry, TankShape};
-use ancf_core::validate::Rng;
 use nalgebra::{Rotation3, Vector3};
 
 struct CountingAllocator;

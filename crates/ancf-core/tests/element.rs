@@ -6,44 +6,10 @@ use ancf_core::constitutive::{Fluid, M3, Rheology};
 use ancf_core::element::VolumetricJacobian::{Generic, Structured};
 use ancf_core::element::{ElementRef, QuadratureOptions, ShapeTables, box_element, to_compact};
 use ancf_core::mesh::{CylinderTankSpec, EllipticCylinderSpec, box_mesh, cylinder_tank, elliptic_cylinder};
+use ancf_core::rng::Rng;
 use ancf_core::shape::{N_COORDS, N_SHAPE};
-use ancf_core::validate::{CASES, Rng, run_case, sample_fluids};
+use ancf_core::testing::sample_fluids;
 use ancf_core::{AncfError, FluidBody};
-
-fn assert_case(name: &str) {
-    let recs = run_case(name, false).unwrap();
-    assert!(!recs.is_empty());
-    for r in &recs {
-        assert!(
-            r.passed,
-            "{}: {} measured {:e} reference {:e} tol {:e}",
-            r.case, r.quantity, r.measured, r.reference, r.tolerance
-        );
-    }
-}
-
-#[test]
-fn validation_case_element_mass() {
-    assert_case("element-mass");
-}
-
-#[test]
-fn validation_case_element_jacobians() {
-    assert_case("element-jacobians");
-}
-
-#[test]
-fn validation_case_rigid_motion_invariance() {
-    assert_case("rigid-motion-invariance");
-}
-
-#[test]
-fn unknown_case_is_an_error_listing_cases() {
-    let err = run_case("nope", true).unwrap_err().to_string();
-    for c in CASES {
-        assert!(err.contains(c), "{err}");
-    }
-}
 
 fn newtonian(mu: f64, k: f64) -> Fluid {
     Fluid::new(1000.0, Rheology::Newtonian { viscosity: mu }, k).unwrap()
@@ -478,7 +444,7 @@ fn jacobians_without_penalty_terms_match_finite_differences() {
     let v: Vec<f64> = e.iter().map(|_| 0.3 * rng.uniform()).collect();
     for rheology in [Rheology::Newtonian { viscosity: 0.7 }, Rheology::Bingham { viscosity: 0.5, yield_stress: 2.0 }] {
         let fluid = Fluid::new(1000.0, rheology, 0.0).unwrap();
-        let (ek, ec) = ancf_core::validate::jacobian_fd_error(&fluid, &el, &tables, &e, &v).unwrap();
+        let (ek, ec) = ancf_core::testing::jacobian_fd_error(&fluid, &el, &tables, &e, &v).unwrap();
         assert!(ek < 1e-6 && ec < 1e-6, "{}: {ek:e} {ec:e}", rheology.name());
     }
 }

@@ -6,8 +6,8 @@
 use ancf_core::constitutive::{DeviatoricPath, Fluid, M3, Rheology, Tangent, newtonian_stress};
 use ancf_core::element::VolumetricJacobian::{Generic, Structured};
 use ancf_core::element::{ElementRef, QuadratureOptions, ShapeTables, box_element, to_compact};
+use ancf_core::rng::Rng;
 use ancf_core::shape::N_COORDS;
-use ancf_core::validate::Rng;
 
 fn fluid(rheology: Rheology) -> Fluid {
     Fluid::new(850.0, rheology, 1.0e6).unwrap()

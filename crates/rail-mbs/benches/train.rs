@@ -38,7 +38,7 @@ use rail_mbs::wheel_rail::{WheelPose, WheelRailContact};
 
 /// Table 1 of seed 000 (the studies' definition).
 fn table1() -> Arc<Track> {
-    rail_mbs::vehicle::studies::table1().expect("table 1 track")
+    rail_mbs::track::presets::table1().expect("table 1 track")
 }
 
 fn tangent() -> Arc<Track> {

@@ -20,7 +20,7 @@ use ancf_core::mesh::{CylinderTankSpec, box_mesh, cylinder_tank};
 use ancf_core::tank::{TankGeometry, TankShape};
 use rail_mbs::defaults::{Oil, liquid, slosh_params};
 use rail_mbs::integrator::ExplicitParams;
-use rail_mbs::slosh::validate::dominant_frequency;
+use rail_mbs::slosh::analysis::dominant_frequency;
 use rail_mbs::slosh::{PiecewiseAcceleration, PrescribedMotion, SloshFrame, SloshRecord, SloshRun, SloshSystem};
 
 use ancf_core::constants::GRAVITY as G;

@@ -6,13 +6,13 @@
 //!
 //! `cargo run --release -p rail-mbs --example patch_models [-- REPEATS]` (default 51).
 //! The data are read from the shared data directory (`RAILSLOSH_SHARED_DATA` or
-//! `../shared/data`, see `wheel_rail::validate`); without them the example says so and
+//! `../shared/data`, see `wheel_rail::manchester`); without them the example says so and
 //! stops.
 
 use std::time::Instant;
 
-use rail_mbs::wheel_rail::validate::{
-    MANCHESTER_DIR, MANCHESTER_FILES, ValidationError, find_dataset, manchester_contact_pair, manchester_patch_case,
+use rail_mbs::wheel_rail::manchester::{
+    DataError, MANCHESTER_DIR, MANCHESTER_FILES, find_dataset, manchester_contact_pair, manchester_patch_case,
     parse_manchester_patches, parse_manchester_reference,
 };
 use rail_mbs::wheel_rail::{CreepModel, PatchModel};
@@ -21,7 +21,7 @@ fn pct(ours: f64, reference: f64) -> f64 {
     100.0 * (ours - reference) / reference.abs()
 }
 
-fn main() -> Result<(), ValidationError> {
+fn main() -> Result<(), DataError> {
     let repeats: usize = std::env::args().nth(1).and_then(|a| a.parse().ok()).unwrap_or(51).max(1);
     let dir = match find_dataset(MANCHESTER_DIR, &MANCHESTER_FILES) {
         Ok(d) => d,
@@ -32,7 +32,7 @@ fn main() -> Result<(), ValidationError> {
     };
     let file = dir.join(MANCHESTER_FILES[0]);
     let text = std::fs::read_to_string(&file)
-        .map_err(|e| ValidationError::BadData { file: file.display().to_string(), message: e.to_string() })?;
+        .map_err(|e| DataError::BadData { file: file.display().to_string(), message: e.to_string() })?;
     let refs = parse_manchester_reference(&text, MANCHESTER_FILES[0])?;
     let maps = parse_manchester_patches(&text, MANCHESTER_FILES[0])?;
     let models = [("Hertz", PatchModel::Hertz), ("KP", PatchModel::kik_piotrowski())];

@@ -25,4 +25,3 @@ pub mod slosh;
 pub mod track;
 pub mod vehicle;
 pub mod wheel_rail;
-pub mod work_precision;

@@ -9,7 +9,7 @@ use std::path::PathBuf;
 mod common;
 
 use rail_mbs::wheel_rail::kik_piotrowski::{DEFAULT_EPSILON, elliptic_limit_force};
-use rail_mbs::wheel_rail::validate::{
+use rail_mbs::wheel_rail::manchester::{
     ManchesterPatch, PatchCase, manchester_contact_pair, manchester_patch_case, parse_manchester_patches,
     parse_manchester_reference,
 };

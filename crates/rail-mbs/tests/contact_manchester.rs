@@ -92,7 +92,7 @@ fn parse_ref(text: &str) -> Vec<RefCase> {
 
 /// The contact pair of the benchmark (the validation case's own construction).
 fn setup(dir: &std::path::Path, model: CreepModel) -> WheelRailContact {
-    rail_mbs::wheel_rail::validate::manchester_contact_pair(dir, model).expect("Manchester contact pair")
+    rail_mbs::wheel_rail::manchester::manchester_contact_pair(dir, model).expect("Manchester contact pair")
 }
 
 fn rot_z(a: f64) -> Matrix3<f64> {

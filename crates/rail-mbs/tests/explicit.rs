@@ -10,7 +10,7 @@ use ancf_core::mesh::box_mesh;
 use ancf_core::tank::{TankGeometry, TankShape};
 use rail_mbs::defaults::liquid;
 use rail_mbs::integrator::{BlockMass, Explicit, ExplicitCheckpoint, ExplicitParams};
-use rail_mbs::slosh::validate::dominant_frequency;
+use rail_mbs::slosh::analysis::dominant_frequency;
 use rail_mbs::slosh::{PiecewiseAcceleration, PrescribedMotion, SloshFrame, SloshRun, SloshSystem};
 
 use ancf_core::constants::GRAVITY as G;

@@ -8,7 +8,7 @@ use crate::compute;
 /// Names of the work–precision sweeps.
 #[pyfunction]
 pub(crate) fn work_precision_cases() -> Vec<&'static str> {
-    rail_mbs::work_precision::CASES.to_vec()
+    railslosh_cases::work_precision::CASES.to_vec()
 }
 
 /// Run one work–precision sweep; returns one dict per point: `case`, `reference`,
@@ -17,7 +17,7 @@ pub(crate) fn work_precision_cases() -> Vec<&'static str> {
 #[pyfunction]
 #[pyo3(signature = (case, quick=false))]
 pub(crate) fn run_work_precision<'py>(py: Python<'py>, case: String, quick: bool) -> PyResult<Vec<Bound<'py, PyDict>>> {
-    let points = compute(py, move || rail_mbs::work_precision::run_case(&case, quick))?;
+    let points = compute(py, move || railslosh_cases::work_precision::run_case(&case, quick))?;
     points
         .into_iter()
         .map(|p| {

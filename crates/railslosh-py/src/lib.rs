@@ -708,12 +708,12 @@ pub(crate) fn margins_dict<'py>(py: Python<'py>, m: &rail_mbs::invariants::Margi
 /// Names of the validation cases implemented in Rust.
 #[pyfunction]
 fn validation_cases() -> Vec<&'static str> {
-    ancf_core::validate::CASES
+    railslosh_cases::element::CASES
         .iter()
-        .chain(rail_mbs::slosh::validate::CASES.iter())
-        .chain(rail_mbs::wheel_rail::validate::CASES.iter())
-        .chain(rail_mbs::vehicle::validate::CASES.iter())
-        .chain(rail_mbs::vehicle::studies::CASES.iter())
+        .chain(railslosh_cases::slosh::CASES.iter())
+        .chain(railslosh_cases::contact::CASES.iter())
+        .chain(railslosh_cases::vehicle::CASES.iter())
+        .chain(railslosh_cases::vehicle::studies::CASES.iter())
         .copied()
         .collect()
 }
@@ -722,19 +722,19 @@ fn validation_cases() -> Vec<&'static str> {
 #[pyfunction]
 #[pyo3(signature = (name, quick=false))]
 fn run_validation<'py>(py: Python<'py>, name: String, quick: bool) -> PyResult<Vec<Bound<'py, PyDict>>> {
-    let recs = if rail_mbs::wheel_rail::validate::CASES.contains(&name.as_str()) {
+    let recs = if railslosh_cases::contact::CASES.contains(&name.as_str()) {
         // Missing external data raise `DataNotFoundError` (reported as skipped).
         rail::run_contact_validation(py, name, quick)?
     } else {
         compute(py, move || {
-            if rail_mbs::slosh::validate::CASES.contains(&name.as_str()) {
-                rail_mbs::slosh::validate::run_case(&name, quick)
-            } else if rail_mbs::vehicle::validate::CASES.contains(&name.as_str()) {
-                rail_mbs::vehicle::validate::run_case(&name, quick)
-            } else if rail_mbs::vehicle::studies::CASES.contains(&name.as_str()) {
-                rail_mbs::vehicle::studies::run_case(&name, quick)
+            if railslosh_cases::slosh::CASES.contains(&name.as_str()) {
+                railslosh_cases::slosh::run_case(&name, quick)
+            } else if railslosh_cases::vehicle::CASES.contains(&name.as_str()) {
+                railslosh_cases::vehicle::run_case(&name, quick)
+            } else if railslosh_cases::vehicle::studies::CASES.contains(&name.as_str()) {
+                railslosh_cases::vehicle::studies::run_case(&name, quick)
             } else {
-                ancf_core::validate::run_case(&name, quick)
+                railslosh_cases::element::run_case(&name, quick)
             }
         })?
     };

@@ -15,11 +15,11 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rail_mbs::profile::{self, Profile, ProfileError, ProfileKind};
 use rail_mbs::track::{INCH, Side, Track, TrackError, TrackPoint};
-use rail_mbs::wheel_rail::validate::ValidationError;
 use rail_mbs::wheel_rail::{
     ContactError, CreepModel, Creepages, FrictionMap, Material, PatchModel, RailGeometry, RailPath, VerticalTarget,
     WheelGeometry, WheelRailContact, WheelState, kik_piotrowski, solve_vertical,
 };
+use railslosh_cases::contact::ValidationError;
 
 use crate::RailsloshError;
 
@@ -112,13 +112,13 @@ fn validation_err(e: ValidationError) -> PyErr {
     }
 }
 
-/// Runs a contact validation case (`rail_mbs::wheel_rail::validate`) for `run_validation`.
+/// Runs a contact validation case (`railslosh_cases::contact`) for `run_validation`.
 pub(crate) fn run_contact_validation(
     py: Python<'_>,
     name: String,
     quick: bool,
-) -> PyResult<Vec<ancf_core::validate::Record>> {
-    guarded(py, move || rail_mbs::wheel_rail::validate::run_case(&name, quick))?.map_err(validation_err)
+) -> PyResult<Vec<railslosh_cases::Record>> {
+    guarded(py, move || railslosh_cases::contact::run_case(&name, quick))?.map_err(validation_err)
 }
 
 // ---------------------------------------------------------------------------------------

@@ -74,7 +74,15 @@
 //! x_p = −(a₀ + s τ)/ω² + 2ζ s/ω³, and the homogeneous remainder is propagated by the
 //! closed-form damped free oscillation. The only error is round-off.
 
+use ancf_core::constants::GRAVITY as G;
 use ancf_core::error::{Result, invalid};
+
+/// Analytic first sloshing frequency of a rectangular tank of length `l` along the motion,
+/// depth `h`: f = √(g k tanh(k h)) / 2π, k = π / l (seed 003 appendix C §4.1).
+pub fn rect_tank_frequency(l: f64, h: f64) -> f64 {
+    let k = std::f64::consts::PI / l;
+    (G * k * (k * h).tanh()).sqrt() / (2.0 * std::f64::consts::PI)
+}
 
 /// Modal mass ratio m_n/m of antisymmetric mode `n` (1-based) of a rectangular tank of
 /// length `length` along the motion and liquid depth `depth`:
@@ -286,8 +294,8 @@ mod tests {
     fn first_mode_is_seed_003_frequency() {
         let f1 = seed_tank().frequencies()[0];
         assert!((f1 / 1.436 - 1.0).abs() < 1e-3, "f1 = {f1}");
-        // and agrees with the validation module's formula
-        let fr = crate::slosh::validate::rect_tank_frequency(L, H);
+        // and agrees with the closed form of the first mode
+        let fr = super::rect_tank_frequency(L, H);
         assert!((f1 - fr).abs() < 1e-12);
         // higher modes: odd wavenumbers only, increasing
         let f = seed_tank().frequencies();

@@ -5,12 +5,12 @@
 //! integrator loop) → [`SloshRecord`] (time series, recorded every step); [`modes`] gives the
 //! small-amplitude modes of a [`SloshSystem`] about a state at rest.
 
+pub mod analysis;
 pub mod linear_theory;
 pub mod modes;
 pub mod motion;
 pub mod scenario;
 pub mod system;
-pub mod validate;
 
 pub use modes::{LinearModes, linear_modes};
 pub use motion::{PiecewiseAcceleration, PrescribedMotion, TankFrameInput, TankFrameSample, TankState};

@@ -37,7 +37,7 @@
 //!   cross-level twist over a base.
 
 use ancf_core::error::{AncfError, invalid};
-use ancf_core::validate::Rng;
+use ancf_core::rng::Rng;
 
 use super::Side;
 

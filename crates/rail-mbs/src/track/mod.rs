@@ -55,6 +55,7 @@ use nalgebra::{Matrix3, Vector3};
 use thiserror::Error;
 
 pub mod irregularity;
+pub mod presets;
 pub use irregularity::{Channel, Defect, Irregularity, IrregularityPsd, TrackSpectrum};
 
 pub use ancf_core::constants::{FOOT, GRAVITY, INCH, MPH};

@@ -36,9 +36,7 @@
 pub mod equivalent;
 pub mod fluid;
 mod run;
-pub mod studies;
 mod tank_car;
-pub mod validate;
 
 pub use equivalent::{
     EquivalentCargo, EquivalentModel, EquivalentTrainFailure, EquivalentTrainRecord, SloshAxis, build_equivalent_train,

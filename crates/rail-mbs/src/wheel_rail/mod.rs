@@ -73,8 +73,8 @@ pub mod creep;
 pub mod friction;
 pub mod hertz;
 pub mod kik_piotrowski;
+pub mod manchester;
 pub mod static_load;
-pub mod validate;
 
 pub use contact::{
     ContactGeometry, ContactMethod, ContactPoint, ContactSettings, RailGeometry, RailPath, WheelGeometry, WheelPose,

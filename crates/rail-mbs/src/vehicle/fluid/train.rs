@@ -31,7 +31,7 @@ pub struct FluidCargo {
     /// Quadrature of the fluid elements.
     pub quadrature: QuadratureOptions,
     /// Wall stiffness as a multiple of the default `k_p = 1000 ρ g` (damping scaled by its
-    /// 3/2 power, keeping the damping ratio), see `slosh::validate::transverse_model`.
+    /// 3/2 power, keeping the damping ratio), see `transverse_model` in `railslosh_cases::slosh`.
     pub wall_stiffness_factor: f64,
     /// Contact points per edge of each boundary face.
     pub contact_points_per_edge: usize,

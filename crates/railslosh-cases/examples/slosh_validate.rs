@@ -1,11 +1,11 @@
 //! Run one slosh validation case and print its records:
-//! `cargo run --release -p rail-mbs --example slosh_validate -- CASE [quick]`.
+//! `cargo run --release -p railslosh-cases --example slosh_validate -- CASE [quick]`.
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let name = args.first().map(String::as_str).unwrap_or("hydrostatic-cylinder");
     let quick = args.iter().any(|a| a == "quick");
     let t = std::time::Instant::now();
-    match rail_mbs::slosh::validate::run_case(name, quick) {
+    match railslosh_cases::slosh::run_case(name, quick) {
         Ok(recs) => {
             for r in recs {
                 println!("{r}");

@@ -9,12 +9,14 @@
 
 use std::sync::Arc;
 
-use super::run::{TrainRecord, TrainScenario, run_train};
-use super::tank_car::TankCarParams;
-use crate::mbs::SpeedProfile;
-use crate::track::{Track, TrackPoint};
 use ancf_core::error::{AncfError, Result, invalid};
-use ancf_core::validate::Record;
+use rail_mbs::mbs::SpeedProfile;
+use rail_mbs::track::{Track, TrackPoint};
+use rail_mbs::vehicle::{TankCarParams, TrainRecord, TrainScenario, run_train};
+
+use crate::Record;
+
+pub mod studies;
 
 /// Names of the vehicle validation cases.
 pub const CASES: [&str; 3] = ["static-wheel-loads", "balance-speed-curving", "lateral-stability"];
@@ -75,7 +77,7 @@ fn static_wheel_loads(quick: bool) -> Result<Vec<Record>> {
 fn curve() -> Result<(Arc<Track>, f64)> {
     let r = 1000.0;
     let v_bal: f64 = 60.0 / 3.6;
-    let e = v_bal * v_bal * Track::DEFAULT_CANT_BASE / (crate::track::GRAVITY * r);
+    let e = v_bal * v_bal * Track::DEFAULT_CANT_BASE / (rail_mbs::track::GRAVITY * r);
     let pts = vec![
         TrackPoint::new(0.0, 1.0 / r, e, 0.0, 0.025, -0.025),
         TrackPoint::new(5000.0, 1.0 / r, e, 0.0, 0.025, -0.025),
@@ -91,7 +93,7 @@ fn balance_speed_curving(quick: bool) -> Result<Vec<Record>> {
     let (t_end, t_avg) = if quick { (2.5, 1.3) } else { (6.0, 2.4) };
     let mut car = loaded_car()?;
     // A US freight car runs on AAR-1B (1:20 tread) wheels; see docs/validation.md for S1002.
-    car.contact.wheel_profile = crate::profile::aar1b_wheel_approx().map_err(|e| invalid("profile", e, "valid"))?;
+    car.contact.wheel_profile = rail_mbs::profile::aar1b_wheel_approx().map_err(|e| invalid("profile", e, "valid"))?;
     let speeds = [0.6 * vb, vb, 1.4 * vb];
     let results: Vec<Result<TrainRecord>> = std::thread::scope(|s| {
         let handles: Vec<_> = speeds

@@ -8,7 +8,7 @@
 //! | `slosh-viscous-decay` | free sloshing after a pulse decays faster from water through the light, medium and heavy crudes of seed 000 Table 2; the heavy crude settles within one period |
 //! | `bulkhead-longitudinal` | under the same braking pulse, a tank car divided into three compartments by two bulkheads has a lower peak longitudinal load than the open tank |
 //! | `tank-frame-equivalence` | the same motion given as tank-frame pseudo-forces (seed 003 eq. 7.40) and as prescribed inertial motion gives the same loads |
-//! | `slosh-linear-potential-flow` | seed 003's rectangular tank under a 0.03 g lateral pulse (linear regime): the lateral load history vs the 50-mode linear potential-flow solution ([`super::linear_theory`]), RMS difference over 0.5–4 s ≤ 10 % of its peak; first-mode frequency from zero crossings vs 1.436 Hz |
+//! | `slosh-linear-potential-flow` | seed 003's rectangular tank under a 0.03 g lateral pulse (linear regime): the lateral load history vs the 50-mode linear potential-flow solution ([`rail_mbs::slosh::linear_theory`]), RMS difference over 0.5–4 s ≤ 10 % of its peak; first-mode frequency from zero crossings vs 1.436 Hz |
 //! | `slosh-load-convergence` | the same tank under a 0.3 g lateral pulse (issue 16 §3): the peak lateral load after the pulse and f₁ from the zero crossings of the raw load change by ≤ 5 % between the two finest of three meshes and between two step sizes; on the finest mesh the raw zero-crossing frequency is within 3 % of the spectral peak (no chatter) |
 //!
 //! `quick` selects coarser meshes and shorter runs (as run in CI); the full forms are the
@@ -21,9 +21,14 @@ use ancf_core::element::QuadratureOptions;
 use ancf_core::error::{AncfError, Result};
 use ancf_core::mesh::{CylinderTankSpec, FluidMesh, box_mesh, cylinder_tank, cylinder_tank_compartments};
 use ancf_core::tank::{Bulkhead, TankGeometry, TankShape};
-use ancf_core::validate::Record;
 
-use super::{PiecewiseAcceleration, PrescribedMotion, SloshFrame, SloshRecord, SloshRun, SloshSystem, linear_modes};
+use rail_mbs::slosh::analysis::dominant_frequency;
+use rail_mbs::slosh::linear_theory::rect_tank_frequency;
+use rail_mbs::slosh::{
+    PiecewiseAcceleration, PrescribedMotion, SloshFrame, SloshRecord, SloshRun, SloshSystem, linear_modes,
+};
+
+use crate::Record;
 
 use ancf_core::constants::GRAVITY as G;
 
@@ -54,7 +59,7 @@ pub fn run_case(name: &str, quick: bool) -> Result<Vec<Record>> {
     }
 }
 
-pub use crate::defaults::{liquid, slosh_params};
+pub use rail_mbs::defaults::{liquid, slosh_params};
 
 #[allow(clippy::too_many_arguments)]
 fn run(
@@ -137,58 +142,6 @@ fn hydrostatic_cylinder(quick: bool) -> Result<Vec<Record>> {
         ),
         Record::abs(c, "centre-of-mass height / R (exact liquid centroid)", zm / r, zc / r, 0.01),
     ])
-}
-
-/// Dominant frequency of `x(t)` for t ≥ t0 in [f_lo, f_hi] Hz: the signal is resampled
-/// uniformly, detrended, Hann-windowed, and the peak of its Fourier amplitude is located on
-/// a fine frequency grid (parabolic refinement). Robust to high-frequency contact chatter.
-pub fn dominant_frequency(t: &[f64], x: &[f64], t0: f64, f_lo: f64, f_hi: f64) -> f64 {
-    let i0 = t.iter().position(|&ti| ti >= t0).unwrap_or(t.len());
-    if t.len() < i0 + 8 {
-        return f64::NAN;
-    }
-    let (ta, tb) = (t[i0], t[t.len() - 1]);
-    let n = 2048;
-    let dt = (tb - ta) / (n - 1) as f64;
-    let mut y = Vec::with_capacity(n);
-    let mut j = i0;
-    for k in 0..n {
-        let tk = ta + k as f64 * dt;
-        while j + 1 < t.len() - 1 && t[j + 1] < tk {
-            j += 1;
-        }
-        let s = ((tk - t[j]) / (t[j + 1] - t[j])).clamp(0.0, 1.0);
-        y.push(x[j] + s * (x[j + 1] - x[j]));
-    }
-    let mean = y.iter().sum::<f64>() / n as f64;
-    for (k, v) in y.iter_mut().enumerate() {
-        let w = 0.5 - 0.5 * (2.0 * std::f64::consts::PI * k as f64 / (n - 1) as f64).cos();
-        *v = (*v - mean) * w;
-    }
-    let amp = |f: f64| {
-        let (mut re, mut im) = (0.0, 0.0);
-        for (k, v) in y.iter().enumerate() {
-            let ph = 2.0 * std::f64::consts::PI * f * k as f64 * dt;
-            re += v * ph.cos();
-            im += v * ph.sin();
-        }
-        (re * re + im * im).sqrt()
-    };
-    let m = 600;
-    let grid: Vec<f64> = (0..=m).map(|i| f_lo + (f_hi - f_lo) * i as f64 / m as f64).collect();
-    let a: Vec<f64> = grid.iter().map(|&f| amp(f)).collect();
-    let ib = (1..m).max_by(|&p, &q| a[p].total_cmp(&a[q])).unwrap_or(1);
-    let (y0, y1, y2) = (a[ib - 1], a[ib], a[ib + 1]);
-    let den = y0 - 2.0 * y1 + y2;
-    let off = if den != 0.0 { 0.5 * (y0 - y2) / den } else { 0.0 };
-    grid[ib] + off * (f_hi - f_lo) / m as f64
-}
-
-/// Analytic first sloshing frequency of a rectangular tank of length `l` along the motion,
-/// depth `h`: f = √(g k tanh(k h)) / 2π, k = π / l (seed 003 appendix C §4.1).
-pub fn rect_tank_frequency(l: f64, h: f64) -> f64 {
-    let k = std::f64::consts::PI / l;
-    (G * k * (k * h).tanh()).sqrt() / (2.0 * std::f64::consts::PI)
 }
 
 fn rect_setup(counts: [usize; 3]) -> Result<(FluidMesh, Fluid, TankGeometry)> {
@@ -634,7 +587,7 @@ fn crossing_frequency(t: &[f64], y: &[f64]) -> f64 {
 /// The pulse: 0.03 g from 0.1 s to 0.5 s with 20 ms linear ramps (0.4 s ≈ 0.57 of the first
 /// period, which puts 97 % of the largest possible residual amplitude into mode 1). The
 /// lateral load on the tank (`force_tank` y) is compared with the 50-mode linear
-/// potential-flow solution ([`super::linear_theory::RectangularTankModes`], undamped, the
+/// potential-flow solution ([`rail_mbs::slosh::linear_theory::RectangularTankModes`], undamped, the
 /// ANCF liquid's mass) at the same times: RMS of the difference over 0.5–4 s, both on a
 /// 1 ms grid, divided by the modal solution's peak |F| over that window, ≤ 0.10.
 ///
@@ -672,7 +625,7 @@ fn slosh_linear_potential_flow(quick: bool) -> Result<Vec<Record>> {
     law.points_per_edge = 4;
     let quad = QuadratureOptions { penalty: 4, ..QuadratureOptions::default() };
     let (rec, mass) = run_with(mesh, fluid, geo, law, quad, motion, SloshFrame::Inertial, t_b, h)?;
-    let modes = super::linear_theory::RectangularTankModes::new(ly, d, mass, G, 50)?;
+    let modes = rail_mbs::slosh::linear_theory::RectangularTankModes::new(ly, d, mass, G, 50)?;
     let n_grid = ((t_b - t_a) / 1e-3).round() as usize;
     let grid: Vec<f64> = (0..=n_grid).map(|i| t_a + (t_b - t_a) * i as f64 / n_grid as f64).collect();
     let f_ref = modes.force_history(&samples, &grid)?;
@@ -802,7 +755,7 @@ fn pulse_load(counts: [usize; 3], h: f64, t_a: f64, t_b: f64) -> Result<PulseLoa
 ///   1.7–1.9 s of the 3.9 s on 2×6×3 and 2×8×4 (Newton retries at contact changes), so only the
 ///   cap of 1 ms changes much.
 ///
-/// Full form (`cargo run --release -p rail-mbs --example slosh_validate -- slosh-load-convergence`,
+/// Full form (`cargo run --release -p railslosh-cases --example slosh_validate -- slosh-load-convergence`,
 /// 399 s): raw peak 48.73 / 53.09 / 68.36 N, raw f 2.371 / 1.3850 / 1.3791 Hz (spectral 1.3857 /
 /// 1.3823 / 1.3782 Hz) on 2×4×2 / 2×6×3 / 2×8×4. Mesh: peak FAILS (22 % change), f passes
 /// (0.4 %). Steps on 2×6×3: peak passes (53.09 vs 53.45 N), raw f FAILS (1.3850 vs 1.7334 Hz:

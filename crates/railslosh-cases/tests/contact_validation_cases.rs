@@ -1,8 +1,8 @@
-//! The wheel/rail validation cases of `railslosh validate` (`rail_mbs::wheel_rail::validate`),
+//! The wheel/rail validation cases of `railslosh validate` (`railslosh_cases::contact`),
 //! quick forms. Without the shared data the Manchester case fails under CI and is skipped
 //! visibly elsewhere (`common::data_missing`).
 
-use rail_mbs::wheel_rail::validate::{CASES, ValidationError, run_case};
+use railslosh_cases::contact::{CASES, ValidationError, run_case};
 
 mod common;
 

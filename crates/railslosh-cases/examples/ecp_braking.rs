@@ -1,8 +1,8 @@
 //! One braking run of the crude-oil studies with its wall time and Newton statistics:
-//! `cargo run --release -p rail-mbs --example ecp_braking -- [light|medium|heavy|water] [nx ny nz] [t_end] [ecp|conventional] [bulkheads|-] [wall_damping_ratio] [condensed|direct] [wall_adhesion]`
+//! `cargo run --release -p railslosh-cases --example ecp_braking -- [light|medium|heavy|water] [nx ny nz] [t_end] [ecp|conventional] [bulkheads|-] [wall_damping_ratio] [condensed|direct] [wall_adhesion]`
 use rail_mbs::defaults::{Oil, SETTLE};
 use rail_mbs::vehicle::BrakeScope;
-use rail_mbs::vehicle::studies::{BrakingCase, run_braking};
+use railslosh_cases::vehicle::studies::{BrakingCase, run_braking};
 
 fn main() {
     let a: Vec<String> = std::env::args().skip(1).collect();

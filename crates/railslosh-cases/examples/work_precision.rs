@@ -1,7 +1,7 @@
 //! One work–precision sweep, printed point by point as it runs (the full sweeps take an
 //! hour or more; `railslosh bench` runs the same sweeps and writes CSV/JSON and a plot):
-//! `cargo run --release -p rail-mbs --example work_precision -- [slosh-tank|ecp-braking|ecp-braking-spread] [quick]`
-use rail_mbs::work_precision::{WorkPoint, run_case_with};
+//! `cargo run --release -p railslosh-cases --example work_precision -- [slosh-tank|ecp-braking|ecp-braking-spread] [quick]`
+use railslosh_cases::work_precision::{WorkPoint, run_case_with};
 
 fn fields(v: &[(String, f64)]) -> String {
     v.iter().map(|(k, x)| format!("{k}={x:.6e}")).collect::<Vec<_>>().join(" ")

@@ -4,79 +4,22 @@
 //! tolerance. The cases are written once here and reused by the Rust tests, the Python
 //! tests and the CLI, so that what CI checks is exactly what users can run.
 
+// Index loops mirror the tensor index notation of the formulas (as in ancf-core).
+#![allow(clippy::needless_range_loop)]
+
 use nalgebra::{Rotation3, Vector3};
 
-use crate::FluidBody;
-use crate::body::rigid_motion;
-use crate::constitutive::{Fluid, M3, Rheology};
-use crate::element::{ElementRef, QuadratureOptions, ShapeTables, box_element};
-use crate::error::Result;
-use crate::mesh::{CylinderTankSpec, EllipticCylinderSpec, box_mesh, cylinder_tank, elliptic_cylinder};
-use crate::shape::{N_COORDS, N_SHAPE};
+use ancf_core::FluidBody;
+use ancf_core::body::rigid_motion;
+use ancf_core::constitutive::{Fluid, M3, Rheology};
+use ancf_core::element::{ElementRef, QuadratureOptions, ShapeTables, box_element};
+use ancf_core::error::Result;
+use ancf_core::mesh::{CylinderTankSpec, EllipticCylinderSpec, box_mesh, cylinder_tank, elliptic_cylinder};
+use ancf_core::rng::Rng;
+use ancf_core::shape::{N_COORDS, N_SHAPE};
+use ancf_core::testing::{jacobian_fd_error, sample_fluids, sample_label};
 
-/// One validation check.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Record {
-    /// Case name (e.g. `element-mass`).
-    pub case: String,
-    /// What was measured.
-    pub quantity: String,
-    /// Measured value.
-    pub measured: f64,
-    /// Reference value.
-    pub reference: f64,
-    /// Allowed |measured − reference| (absolute unless the quantity says "relative").
-    pub tolerance: f64,
-    /// Whether the check passed.
-    pub passed: bool,
-}
-
-/// One line: case, quantity, measured, reference, tolerance and verdict.
-impl std::fmt::Display for Record {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "{} {}: measured {:.6} reference {:.6} tol {:.3e} -> {}",
-            self.case,
-            self.quantity,
-            self.measured,
-            self.reference,
-            self.tolerance,
-            if self.passed { "ok" } else { "FAIL" }
-        )
-    }
-}
-
-impl Record {
-    /// Check |measured − reference| ≤ tolerance.
-    pub fn abs(case: &str, quantity: impl Into<String>, measured: f64, reference: f64, tolerance: f64) -> Self {
-        let passed = (measured - reference).abs() <= tolerance && measured.is_finite();
-        Self { case: case.into(), quantity: quantity.into(), measured, reference, tolerance, passed }
-    }
-    /// Check |measured| ≤ limit.
-    pub fn at_most(case: &str, quantity: impl Into<String>, measured: f64, limit: f64) -> Self {
-        Self {
-            case: case.into(),
-            quantity: quantity.into(),
-            measured,
-            reference: 0.0,
-            tolerance: limit,
-            passed: measured.is_finite() && measured.abs() <= limit,
-        }
-    }
-    /// Check measured < limit (signed; the limit is reported as the reference, with a zero
-    /// tolerance).
-    pub fn less_than(case: &str, quantity: impl Into<String>, measured: f64, limit: f64) -> Self {
-        Self {
-            case: case.into(),
-            quantity: quantity.into(),
-            measured,
-            reference: limit,
-            tolerance: 0.0,
-            passed: measured.is_finite() && measured < limit,
-        }
-    }
-}
+use crate::Record;
 
 /// Names of the cases this module provides.
 pub const CASES: [&str; 3] = ["element-mass", "element-jacobians", "rigid-motion-invariance"];
@@ -87,53 +30,8 @@ pub fn run_case(name: &str, quick: bool) -> Result<Vec<Record>> {
         "element-mass" => element_mass(),
         "element-jacobians" => element_jacobians(if quick { 2 } else { 6 }),
         "rigid-motion-invariance" => rigid_motion_invariance(if quick { 3 } else { 10 }),
-        other => Err(crate::error::invalid("case", other, &format!("one of {CASES:?}"))),
+        other => Err(ancf_core::error::invalid("case", other, &format!("one of {CASES:?}"))),
     }
-}
-
-/// Small deterministic pseudo-random generator (SplitMix64), uniform in [-1, 1).
-#[derive(Debug, Clone)]
-pub struct Rng(u64);
-
-impl Rng {
-    /// Seeded generator.
-    pub fn new(seed: u64) -> Self {
-        Self(seed)
-    }
-    /// Next number in [-1, 1).
-    pub fn uniform(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E3779B97F4A7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58476D1CE4E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D049BB133111EB);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-    }
-    /// A random unit-ish vector scaled by `s`.
-    pub fn vec3(&mut self, s: f64) -> [f64; 3] {
-        [s * self.uniform(), s * self.uniform(), s * self.uniform()]
-    }
-}
-
-/// The five rheologies with representative parameters, and a penalty; the sixth is the
-/// Newtonian one with the shear stabilization ([`Fluid::shear_stabilization`]).
-pub fn sample_fluids() -> Vec<Fluid> {
-    let mk = |rheology| Fluid { bulk_damping: 20.0, ..Fluid::new(900.0, rheology, 2.0e5).expect("valid") };
-    let newtonian = mk(Rheology::Newtonian { viscosity: 0.8 });
-    vec![
-        newtonian,
-        mk(Rheology::Bingham { viscosity: 0.5, yield_stress: 3.0 }),
-        mk(Rheology::HerschelBulkley { consistency: 0.7, power_index: 0.6, yield_stress: 2.0 }),
-        mk(Rheology::Oldroyd { viscosity: 0.5, yield_stress: 40.0, elastic_modulus: Some(800.0) }),
-        mk(Rheology::Casson { viscosity: 0.4, yield_stress: 2.5 }),
-        Fluid { shear_stabilization: 300.0, ..newtonian },
-    ]
-}
-
-/// The name of a sample fluid in records: its law, and "+ shear stabilization" when it has one.
-pub fn sample_label(fluid: &Fluid) -> String {
-    let name = fluid.rheology.name();
-    if fluid.shear_stabilization > 0.0 { format!("{name} + shear stabilization") } else { name.to_string() }
 }
 
 fn element_mass() -> Result<Vec<Record>> {
@@ -158,7 +56,7 @@ fn element_mass() -> Result<Vec<Record>> {
     let mmat = faer::Mat::from_fn(N_SHAPE, N_SHAPE, |i, j| m[i * N_SHAPE + j]);
     let eig = mmat
         .self_adjoint_eigenvalues(faer::Side::Lower)
-        .map_err(|_| crate::error::AncfError::NonFinite { what: "mass eigenvalues".into(), element: 0 })?;
+        .map_err(|_| ancf_core::error::AncfError::NonFinite { what: "mass eigenvalues".into(), element: 0 })?;
     let lmin = eig.iter().copied().fold(f64::INFINITY, f64::min);
     out.push(Record {
         case: c.into(),
@@ -168,7 +66,7 @@ fn element_mass() -> Result<Vec<Record>> {
         tolerance: 0.0,
         passed: lmin > 0.0,
     });
-    let g = crate::constants::GRAVITY;
+    let g = ancf_core::constants::GRAVITY;
     let gs = el.gravity_scale(rho, &tables);
     out.push(Record::abs(c, "gravity force, position entry (N): -rho V g / 8", -gs[0] * g, -rho * g / 8.0, 1e-8));
     out.push(Record::abs(
@@ -238,42 +136,6 @@ fn random_state(rng: &mut Rng, e0: &[[f64; 3]; N_SHAPE], amp: f64, vamp: f64) ->
     (e, v)
 }
 
-/// Max relative finite-difference error of K = ∂f/∂e and C = ∂f/∂ė of one element.
-pub fn jacobian_fd_error(
-    fluid: &Fluid,
-    el: &ElementRef,
-    tables: &ShapeTables,
-    e: &[f64],
-    v: &[f64],
-) -> Result<(f64, f64)> {
-    let cpt = crate::element::to_compact;
-    let mut f0 = [0.0; N_COORDS];
-    let mut k = vec![0.0; N_COORDS * N_COORDS];
-    let mut cm = vec![0.0; N_COORDS * N_COORDS];
-    el.internal_force(0, fluid, tables, &cpt(e), &cpt(v), &mut f0, Some((&mut k, &mut cm)))?;
-    let mut errs = [0.0f64; 2];
-    for (w, jac) in [&k, &cm].into_iter().enumerate() {
-        let scale = jac.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        let mut worst = 0.0f64;
-        for d in 0..N_COORDS {
-            let h = 1e-6;
-            let (mut xp, mut xm) = if w == 0 { (e.to_vec(), e.to_vec()) } else { (v.to_vec(), v.to_vec()) };
-            xp[d] += h;
-            xm[d] -= h;
-            let (mut fp, mut fm) = ([0.0; N_COORDS], [0.0; N_COORDS]);
-            let (ep, em, vp, vm) = if w == 0 { (&xp[..], &xm[..], v, v) } else { (e, e, &xp[..], &xm[..]) };
-            el.internal_force(0, fluid, tables, &cpt(ep), &cpt(vp), &mut fp, None)?;
-            el.internal_force(0, fluid, tables, &cpt(em), &cpt(vm), &mut fm, None)?;
-            for r in 0..N_COORDS {
-                let fd = (fp[r] - fm[r]) / (2.0 * h);
-                worst = worst.max((fd - jac[r * N_COORDS + d]).abs());
-            }
-        }
-        errs[w] = worst / scale.max(1e-300);
-    }
-    Ok((errs[0], errs[1]))
-}
-
 fn element_jacobians(samples: usize) -> Result<Vec<Record>> {
     let c = "element-jacobians";
     let mut out = Vec::new();
@@ -289,7 +151,7 @@ fn element_jacobians(samples: usize) -> Result<Vec<Record>> {
             let mut fl = fluid;
             if let Rheology::Oldroyd { viscosity, elastic_modulus, .. } = fluid.rheology {
                 // put the first viscous point inside the elastic/viscous blend band
-                let ehat = crate::element::scaled(&crate::element::to_compact(&e), &el.scale);
+                let ehat = ancf_core::element::scaled(&ancf_core::element::to_compact(&e), &el.scale);
                 let mut fhat = M3::zeros();
                 for a in 0..N_SHAPE {
                     for i in 0..3 {
@@ -300,7 +162,7 @@ fn element_jacobians(samples: usize) -> Result<Vec<Record>> {
                 }
                 let f = fhat * el.viscous[0].jinv;
                 let g = elastic_modulus.unwrap_or(0.0);
-                let se = 2.0 * g * crate::constitutive::dev(&(0.5 * (f.transpose() * f - M3::identity())));
+                let se = 2.0 * g * ancf_core::constitutive::dev(&(0.5 * (f.transpose() * f - M3::identity())));
                 let ne = (0.5 * se.component_mul(&se).sum()).sqrt();
                 fl.rheology = Rheology::Oldroyd { viscosity, yield_stress: ne * 1.01, elastic_modulus };
             }

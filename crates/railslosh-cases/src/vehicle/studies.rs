@@ -32,16 +32,16 @@ use std::sync::Arc;
 
 use ancf_core::element::QuadratureOptions;
 use ancf_core::error::{AncfError, Result, invalid};
-use ancf_core::validate::Record;
+use rail_mbs::mbs::SpeedProfile;
+use rail_mbs::track::presets::{TABLE1_BODY_END, table1};
+use rail_mbs::track::{GRAVITY, Track};
+use rail_mbs::vehicle::equivalent::cylinder_lambda;
+use rail_mbs::vehicle::fluid::{FluidCargo, FluidTrainRecord, run_fluid_train};
+use rail_mbs::vehicle::{BrakeScope, TankCarParams, TrainScenario};
 
-use super::equivalent::cylinder_lambda;
-use super::fluid::{FluidCargo, FluidTrainRecord, run_fluid_train};
-use super::run::{BrakeScope, TrainScenario};
-use super::tank_car::TankCarParams;
-use crate::mbs::SpeedProfile;
-use crate::track::{FOOT, GRAVITY, Track, TrackPoint};
+use crate::Record;
 
-pub use crate::defaults::{Oil, SETTLE, brake_torque};
+pub use rail_mbs::defaults::{Oil, SETTLE, brake_torque};
 
 /// A braking run of the studies.
 #[derive(Debug, Clone)]
@@ -68,7 +68,7 @@ pub struct BrakingCase {
     /// 0, or 4 as the shipped ECP scenes use).
     pub wall_adhesion: f64,
     /// How the coupled Newton matrix is solved ([`FluidCargo::linear_solver`]).
-    pub linear_solver: crate::integrator::LinearSolverKind,
+    pub linear_solver: rail_mbs::integrator::LinearSolverKind,
 }
 
 fn tangent() -> Result<Arc<Track>> {
@@ -84,7 +84,7 @@ fn cargo(oil: Oil, counts: [usize; 3], bulkheads: bool, p: &TankCarParams) -> Re
 }
 
 fn finish(
-    out: std::result::Result<FluidTrainRecord, Box<super::fluid::FluidTrainFailure>>,
+    out: std::result::Result<FluidTrainRecord, Box<rail_mbs::vehicle::fluid::FluidTrainFailure>>,
 ) -> Result<FluidTrainRecord> {
     out.map_err(|f| {
         AncfError::Solver(format!("{} (at t = {:.3} s)", f.error, f.record.train.t.last().copied().unwrap_or(0.0)))
@@ -213,7 +213,7 @@ fn braking(oil: Oil, cars: usize, scope: BrakeScope, bulkheads: bool, quick: boo
         rear_brake_factor: rear,
         wall_damping_ratio: ancf_core::contact::WALL_DAMPING_RATIO,
         wall_adhesion: 0.0,
-        linear_solver: crate::integrator::LinearSolverKind::Condensed,
+        linear_solver: rail_mbs::integrator::LinearSolverKind::Condensed,
     }
 }
 
@@ -373,29 +373,6 @@ fn bulkhead_reduction(quick: bool) -> Result<Vec<Record>> {
     ])
 }
 
-/// Seed 000 Table 1 track: (distance ft, curvature degrees, super-elevation in).
-const TABLE1_ROWS: [(f64, f64, f64); 10] = [
-    (0.0, 0.0, 0.0),
-    (100.0, 0.0, 0.0),
-    (300.0, 3.0, 3.0),
-    (600.0, 3.0, 3.0),
-    (800.0, 0.0, 0.0),
-    (1000.0, 0.0, 0.0),
-    (1200.0, -3.0, -3.0),
-    (1500.0, -3.0, -3.0),
-    (1700.0, 0.0, 0.0),
-    (2800.0, 0.0, 0.0),
-];
-
-/// Seed 000 Table 1 track (US units).
-pub fn table1() -> Result<Arc<Track>> {
-    let pts = TABLE1_ROWS.iter().map(|&(d, c, e)| TrackPoint::from_us(d, c, e, 0.0, 0.025, -0.025)).collect();
-    Track::new(pts).map(Arc::new).map_err(|e| invalid("track", e, "valid"))
-}
-
-/// End of the body (constant curvature) of the first Table 1 curve, m.
-pub const TABLE1_BODY_END: f64 = TABLE1_ROWS[3].0 * FOOT;
-
 /// Outward inertia force and in-plane gravity component of the oil (mean over the last
 /// period of the first transverse slosh mode) for one car driven at `speed` through the Table 1 curve. The run starts with the
 /// tank centre at 110 m, inside the body of the 3° curve (91.4–182.9 m), and ends at
@@ -516,7 +493,7 @@ fn mesh_convergence(quick: bool) -> Result<Vec<Record>> {
                     rear_brake_factor: 1.0,
                     wall_damping_ratio: ancf_core::contact::WALL_DAMPING_RATIO,
                     wall_adhesion: 0.0,
-                    linear_solver: crate::integrator::LinearSolverKind::Condensed,
+                    linear_solver: rail_mbs::integrator::LinearSolverKind::Condensed,
                 })
             }) as Job<'static, FluidTrainRecord>
         })
@@ -590,7 +567,7 @@ fn coupler_force_convergence(quick: bool) -> Result<Vec<Record>> {
             rear_brake_factor: 1.0,
             wall_damping_ratio: 1.0,
             wall_adhesion: 4.0,
-            linear_solver: crate::integrator::LinearSolverKind::Condensed,
+            linear_solver: rail_mbs::integrator::LinearSolverKind::Condensed,
         };
         for m in meshes {
             jobs.push(Box::new(move || run_braking(&case(m))));

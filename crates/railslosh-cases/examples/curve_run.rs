@@ -1,8 +1,8 @@
 //! One run of the crude-oil curve study (seed 000 §8.5: one car driven through the Table 1
 //! curve), printing the oil's outward inertia force, the in-plane gravity component and the
-//! wall time: `cargo run --release -p rail-mbs --example curve_run -- [light|medium|heavy|water] [km/h] [nx ny nz] [t_end]`
+//! wall time: `cargo run --release -p railslosh-cases --example curve_run -- [light|medium|heavy|water] [km/h] [nx ny nz] [t_end]`
 use rail_mbs::defaults::Oil;
-use rail_mbs::vehicle::studies::curve_run;
+use railslosh_cases::vehicle::studies::curve_run;
 
 fn main() {
     let a: Vec<String> = std::env::args().skip(1).collect();

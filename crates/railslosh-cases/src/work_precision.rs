@@ -25,12 +25,14 @@ use ancf_core::error::{AncfError, Result};
 use ancf_core::mesh::box_mesh;
 use ancf_core::tank::{TankGeometry, TankShape};
 
-use crate::defaults::{Oil, SETTLE};
-use crate::defaults::{liquid, slosh_params};
-use crate::integrator::{IterativeParams, LinearSolverKind};
-use crate::slosh::validate::{dominant_frequency, rect_tank_frequency};
-use crate::slosh::{PiecewiseAcceleration, PrescribedMotion, SloshFrame, SloshRecord, SloshRun, SloshSystem};
-use crate::vehicle::BrakeScope;
+use rail_mbs::defaults::{Oil, SETTLE};
+use rail_mbs::defaults::{liquid, slosh_params};
+use rail_mbs::integrator::{IterativeParams, LinearSolverKind};
+use rail_mbs::slosh::analysis::dominant_frequency;
+use rail_mbs::slosh::linear_theory::rect_tank_frequency;
+use rail_mbs::slosh::{PiecewiseAcceleration, PrescribedMotion, SloshFrame, SloshRecord, SloshRun, SloshSystem};
+use rail_mbs::vehicle::BrakeScope;
+
 use crate::vehicle::studies::{BrakingCase, run_braking_with};
 
 use ancf_core::constants::GRAVITY as G;
@@ -128,7 +130,7 @@ struct SloshSetting {
 struct SloshOutcome {
     record: SloshRecord,
     wall: f64,
-    stats: crate::integrator::Stats,
+    stats: rail_mbs::integrator::Stats,
     failure: Option<String>,
 }
 
@@ -286,16 +288,17 @@ fn ecp_braking(
             rear_brake_factor,
             wall_damping_ratio: ancf_core::contact::WALL_DAMPING_RATIO,
             wall_adhesion: 0.0,
-            linear_solver: crate::integrator::LinearSolverKind::Condensed,
+            linear_solver: rail_mbs::integrator::LinearSolverKind::Condensed,
         };
         let tic = Instant::now();
         let out = run_braking_with(&case, s.step, s.rel_tol);
         (out, tic.elapsed().as_secs_f64())
     };
-    let peak = |r: &crate::vehicle::FluidTrainRecord| -> f64 {
+    let peak = |r: &rail_mbs::vehicle::FluidTrainRecord| -> f64 {
         r.train.coupler_force.iter().map(|c| c.first().map_or(0.0, |f| f.abs())).fold(0.0, f64::max)
     };
-    let com_x = |r: &crate::vehicle::FluidTrainRecord| -> Vec<f64> { r.oil_com_tank.iter().map(|c| c[0][0]).collect() };
+    let com_x =
+        |r: &rail_mbs::vehicle::FluidTrainRecord| -> Vec<f64> { r.oil_com_tank.iter().map(|c| c[0][0]).collect() };
     let (ref_out, ref_wall) = run(reference);
     let ref_rec = ref_out?;
     let (p_ref, c_ref) = (peak(&ref_rec), com_x(&ref_rec));
