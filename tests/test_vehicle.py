@@ -109,3 +109,35 @@ def test_loads_are_recorded_as_anti_aliased_hat_means_and_say_so():
     assert np.abs(mean["coupler_force"] - point["coupler_force"]).max() > 1e-2 * scale
     with pytest.raises(ValueError, match="load_filter"):
         vehicle.run(TANGENT, t_end=0.1, load_filter="butterworth")
+
+
+def test_a_derailing_car_stops_with_the_typed_wheel_off_rail_error():
+    """Run-time invariant of vehicle runs (``rail_mbs::vehicle::WHEEL_OFF_RAIL_LIMIT``): a wheel that
+    carries no load for more than 0.1 s has left the rail. Here the loaded car is driven at 30 km/h
+    into a 150 m curve without superelevation: the front wheelset climbs the rail and falls off it
+    (measured before the check: both front wheelsets at 0 N from 2.2-2.4 s on, L/V 2.16 on the third,
+    and the run exited normally to 3 s). Now it stops at 2.15 s naming the wheel, with what was
+    recorded up to there."""
+    r = 150.0
+    rows = [[0, 0, 0, 0, 0.025, -0.025], [62, 0, 0, 0, 0.025, -0.025], [70, 1 / r, 0, 0, 0.025, -0.025]]
+    rows.append([600, 1 / r, 0, 0, 0.025, -0.025])
+    with pytest.raises(SimulationError) as info:
+        vehicle.run(
+            rows,
+            cars=1,
+            station=50.0,
+            speed=30 / 3.6,
+            t_end=3.0,
+            step=2e-3,
+            record_every=0.01,
+            drive=True,
+            lading_mass=36000.0,
+            lading_height=-0.5,
+        )
+    e = info.value
+    assert e.cause == "wheel_off_rail", str(e)
+    assert "wheelset 0 (front to rear), left wheel carried no load" in str(e)
+    t = np.asarray(e.results["t"])
+    assert 1.8 < t[-1] < 2.6
+    q = np.asarray(e.results["wheel_vertical"])
+    assert q[-1, 0, 0] == 0.0 and q[0].min() > 7e4  # the wheel at 0 N at the end; all loaded at the start

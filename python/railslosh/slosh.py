@@ -106,6 +106,7 @@ FAILURE_CAUSES: tuple[tuple[str, str], ...] = (
     ("containment", r"not contained: "),
     ("energy_growth", r"energy balance broken"),
     ("distorted_element", r"distorted: J ="),
+    ("wheel_off_rail", r"wheel off the rail"),
     ("contact_penetration", r"penetration .* beyond its limit"),
     ("volume_error", r"volume .* deviates from its reference"),
     ("inverted_element", r"inverted: J =|inverted element|J = [-+0-9.e]+ <= 0"),

@@ -148,6 +148,26 @@ pub enum SystemError {
         /// Admissible growth.
         limit: f64,
     },
+    /// A wheel carried no load for longer than the admissible time (run-time invariant of
+    /// vehicle runs, [`crate::vehicle::WHEEL_OFF_RAIL_LIMIT`]): the wheel has left the rail
+    /// (derailment, or a wheel lift far longer than track tests admit).
+    #[error(
+        "wheel off the rail: wheelset {wheelset} (front to rear), {side} wheel carried no load from t = {since:.3} s to {t:.3} s, longer than {limit} s (wheelset lateral displacement {lateral:.4} m)"
+    )]
+    WheelOffRail {
+        /// Wheelset index, front to rear over the train.
+        wheelset: usize,
+        /// "left" or "right".
+        side: &'static str,
+        /// Time of the first sample without load, s.
+        since: f64,
+        /// Time of this sample, s.
+        t: f64,
+        /// Admissible time without load, s.
+        limit: f64,
+        /// Lateral displacement of the wheelset from the track centreline, m.
+        lateral: f64,
+    },
     /// Any other model failure.
     #[error("{0}")]
     Other(String),
@@ -347,6 +367,8 @@ pub enum FailureCause {
     EnergyGrowth,
     /// An element distorted beyond the admissible volume ratio (run-time invariant).
     DistortedElement,
+    /// A wheel left the rail (run-time invariant of vehicle runs).
+    WheelOffRail,
     /// Another model failure.
     Model,
 }
@@ -366,6 +388,7 @@ impl FailureCause {
             Self::Containment => "containment",
             Self::EnergyGrowth => "energy_growth",
             Self::DistortedElement => "distorted_element",
+            Self::WheelOffRail => "wheel_off_rail",
             Self::Model => "model",
         }
     }
@@ -404,6 +427,7 @@ impl IntegratorError {
                 SystemError::Containment { .. } => FailureCause::Containment,
                 SystemError::EnergyGrowth { .. } => FailureCause::EnergyGrowth,
                 SystemError::DistortedElement { .. } => FailureCause::DistortedElement,
+                SystemError::WheelOffRail { .. } => FailureCause::WheelOffRail,
                 _ => FailureCause::Model,
             },
         }

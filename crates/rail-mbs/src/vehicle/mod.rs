@@ -47,8 +47,9 @@ pub use fluid::{
     run_fluid_train_observed, run_fluid_train_streamed,
 };
 pub use run::{
-    BrakeScope, LoadFilter, Observer, Progress, SampleSink, TrainFailure, TrainRecord, TrainScenario, build_train,
-    hat_mean_resample, run_train, run_train_observed, run_train_streamed, stopped_by_observer,
+    BrakeScope, LoadFilter, Observer, Progress, SampleSink, TrainFailure, TrainRecord, TrainScenario,
+    WHEEL_OFF_RAIL_LIMIT, build_train, hat_mean_resample, run_train, run_train_observed, run_train_streamed,
+    stopped_by_observer,
 };
 pub use tank_car::{
     BodyMass, CarBodies, CarPlacement, ContactParams, SuspensionParams, TankCarParams, WheelLoad, add_coupler,

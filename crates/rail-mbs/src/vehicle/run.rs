@@ -608,6 +608,52 @@ pub(crate) fn step_and_record<S: crate::integrator::MechanicalSystem>(
     result
 }
 
+/// Longest time a wheel may carry no load before a vehicle run stops with
+/// [`SystemError::WheelOffRail`](crate::integrator::SystemError::WheelOffRail), s. Short wheel
+/// lifts are part of running on real track (single samples at 0 N over a dip); a wheel without
+/// load for 0.1 s has travelled 1–3 m off the rail at the speeds here: the run no longer
+/// describes a train on its track, and what it computes after that is not a valid answer.
+pub const WHEEL_OFF_RAIL_LIMIT: f64 = 0.1;
+
+/// Watches every wheel's vertical load sample by sample ([`WHEEL_OFF_RAIL_LIMIT`]).
+#[derive(Debug, Default)]
+struct WheelLiftWatch {
+    /// Per wheelset and side: the time of the first sample of the current run without load.
+    since: Vec<[Option<f64>; 2]>,
+}
+
+impl WheelLiftWatch {
+    /// Checks sample `k` of `rec`: a wheel with no load since longer than the limit is an error.
+    fn check(&mut self, rec: &TrainRecord, k: usize) -> Result<(), IntegratorError> {
+        let (Some(&t), Some(q)) = (rec.t.get(k), rec.wheel_vertical.get(k)) else { return Ok(()) };
+        self.since.resize(q.len(), [None, None]);
+        for (w, (loads, since)) in q.iter().zip(&mut self.since).enumerate() {
+            for side in 0..2 {
+                if loads[side] > 0.0 {
+                    since[side] = None;
+                    continue;
+                }
+                let t0 = *since[side].get_or_insert(t);
+                if t - t0 > WHEEL_OFF_RAIL_LIMIT {
+                    let lateral = rec.wheelset_lateral.get(k).and_then(|l| l.get(w)).copied().unwrap_or(f64::NAN);
+                    return Err(IntegratorError::System {
+                        t,
+                        source: crate::integrator::SystemError::WheelOffRail {
+                            wheelset: w,
+                            side: ["left", "right"][side],
+                            since: t0,
+                            t,
+                            limit: WHEEL_OFF_RAIL_LIMIT,
+                            lateral,
+                        },
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
 /// What one kind of train run (rigid lading, equivalent slosh model, ANCF fluid) records: its
 /// record and how it samples the vehicle and its cargo. [`drive`] is the one run loop over
 /// every kind.
@@ -660,8 +706,12 @@ pub(crate) fn drive<R: TrainRun>(
         }
     };
     let mut scratch = R::Record::default();
+    let mut wheels = WheelLiftWatch::default();
     let result = step_and_record(&mut hht, sc, observe, |hht, event| match event {
-        RecordEvent::Sample(k) => run.sample(hht, k, &mut rec, true),
+        RecordEvent::Sample(k) => {
+            run.sample(hht, k, &mut rec, true)?;
+            wheels.check(R::train(&mut rec), k)
+        }
         RecordEvent::Loads(out) => {
             R::clear_samples(&mut scratch);
             run.sample(hht, 0, &mut scratch, false)?;
@@ -764,6 +814,56 @@ pub fn run_train_streamed(
     let hints = cars.iter().flat_map(|c| [c.station; 4]).collect();
     let run = RigidRun { sc, cars, couplers, hints };
     Ok(drive(run, mb, init, sc, observe, sink, rec).map_err(|(error, record)| Box::new(TrainFailure { error, record })))
+}
+
+#[cfg(test)]
+mod wheel_lift_tests {
+    use super::*;
+
+    /// A record whose wheelset 1's right wheel carries no load from sample `from` on.
+    fn record(n: usize, dt: f64, from: usize) -> TrainRecord {
+        let mut r = TrainRecord::default();
+        for k in 0..n {
+            r.t.push(k as f64 * dt);
+            let off = if k >= from { 0.0 } else { 7e4 };
+            r.wheel_vertical.push(vec![[7e4, 7e4], [7e4, off]]);
+            r.wheelset_lateral.push(vec![0.0, 0.012]);
+        }
+        r
+    }
+
+    #[test]
+    fn a_wheel_without_load_for_longer_than_the_limit_stops_the_run_and_a_short_lift_does_not() {
+        let dt = 0.02;
+        // 5 samples without load span 0.08 s: a lift, not an error
+        let short = record(20, dt, 10);
+        let mut w = WheelLiftWatch::default();
+        for k in 0..15 {
+            w.check(&short, k).unwrap();
+        }
+        // the load comes back: the count restarts
+        let mut back = short.clone();
+        back.wheel_vertical[15][1][1] = 100.0;
+        for k in 15..20 {
+            w.check(&back, k).unwrap();
+        }
+        // without load from 0.2 s: the sample at 0.32 s (> 0.1 s later) is the error, named
+        let long = record(20, dt, 10);
+        let mut w = WheelLiftWatch::default();
+        let mut stopped = None;
+        for k in 0..20 {
+            if let Err(e) = w.check(&long, k) {
+                stopped = Some((k, e));
+                break;
+            }
+        }
+        let (k, e) = stopped.expect("the run stops");
+        assert_eq!(k, 16);
+        assert_eq!(e.cause(), crate::integrator::FailureCause::WheelOffRail);
+        let m = e.to_string();
+        assert!(m.contains("wheel off the rail: wheelset 1") && m.contains("right wheel") && m.contains("0.0120 m"), "{m}");
+        assert!(m.contains("from t = 0.200 s to 0.320 s"), "{m}");
+    }
 }
 
 #[cfg(test)]
