@@ -1081,6 +1081,47 @@ mod tests {
         (body, contact, kin, e, edot)
     }
 
+    /// The point Jacobians `jac` of `contact` at `(e, edot)`, assembled, equal central
+    /// differences of its forces (h = 1e-7) to 1e-6 of their largest entry.
+    fn assert_jacobians_match_fd(
+        contact: &WallContact,
+        body: &FluidBody,
+        kin: &TankKinematics,
+        e: &[f64],
+        edot: &[f64],
+        jac: &[PointJacobian],
+        label: &str,
+    ) {
+        let n = body.n_coords();
+        let mut kr = vec![0.0; n * n];
+        let mut kv = vec![0.0; n * n];
+        dense_jacobians(contact, body, jac, &mut kr, &mut kv);
+        for (which, k) in [(0, &kr), (1, &kv)] {
+            let scale = k.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            let mut worst = 0.0f64;
+            for d in 0..n {
+                let h = 1e-7;
+                let (mut xp, mut xm) =
+                    if which == 0 { (e.to_vec(), e.to_vec()) } else { (edot.to_vec(), edot.to_vec()) };
+                xp[d] += h;
+                xm[d] -= h;
+                let (mut qp, mut qm) = (vec![0.0; n], vec![0.0; n]);
+                if which == 0 {
+                    contact.forces(body, kin, &xp, edot, &mut qp, None);
+                    contact.forces(body, kin, &xm, edot, &mut qm, None);
+                } else {
+                    contact.forces(body, kin, e, &xp, &mut qp, None);
+                    contact.forces(body, kin, e, &xm, &mut qm, None);
+                }
+                for r in 0..n {
+                    let fd = (qp[r] - qm[r]) / (2.0 * h);
+                    worst = worst.max((fd - k[r * n + d]).abs());
+                }
+            }
+            assert!(worst / scale < 1e-6, "{label} {which}: {:.2e}", worst / scale);
+        }
+    }
+
     #[test]
     fn contact_jacobians_match_finite_differences() {
         for friction in [
@@ -1094,33 +1135,7 @@ mod tests {
             let mut jac = Vec::new();
             let load = contact.forces(&body, &kin, &e, &edot, &mut q, Some(&mut jac));
             assert!(load.active > 10, "active {}", load.active);
-            let mut kr = vec![0.0; n * n];
-            let mut kv = vec![0.0; n * n];
-            dense_jacobians(&contact, &body, &jac, &mut kr, &mut kv);
-            for (which, k) in [(0, &kr), (1, &kv)] {
-                let scale = k.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-                let mut worst = 0.0f64;
-                for d in 0..n {
-                    let h = 1e-7;
-                    let (mut xp, mut xm) =
-                        if which == 0 { (e.clone(), e.clone()) } else { (edot.clone(), edot.clone()) };
-                    xp[d] += h;
-                    xm[d] -= h;
-                    let (mut qp, mut qm) = (vec![0.0; n], vec![0.0; n]);
-                    if which == 0 {
-                        contact.forces(&body, &kin, &xp, &edot, &mut qp, None);
-                        contact.forces(&body, &kin, &xm, &edot, &mut qm, None);
-                    } else {
-                        contact.forces(&body, &kin, &e, &xp, &mut qp, None);
-                        contact.forces(&body, &kin, &e, &xm, &mut qm, None);
-                    }
-                    for r in 0..n {
-                        let fd = (qp[r] - qm[r]) / (2.0 * h);
-                        worst = worst.max((fd - k[r * n + d]).abs());
-                    }
-                }
-                assert!(worst / scale < 1e-6, "{friction:?} {which}: {:.2e}", worst / scale);
-            }
+            assert_jacobians_match_fd(&contact, &body, &kin, &e, &edot, &jac, &format!("{friction:?}"));
         }
     }
 
@@ -1297,33 +1312,7 @@ mod tests {
             let full = contact.forces_full(&body, &kin, &e, &edot, &mut q_full, None);
             assert_eq!(q, q_full);
             assert_eq!(load.force, full.force);
-            let mut kr = vec![0.0; n * n];
-            let mut kv = vec![0.0; n * n];
-            dense_jacobians(&contact, &body, &jac, &mut kr, &mut kv);
-            for (which, k) in [(0, &kr), (1, &kv)] {
-                let scale = k.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-                let mut worst = 0.0f64;
-                for d in 0..n {
-                    let h = 1e-7;
-                    let (mut xp, mut xm) =
-                        if which == 0 { (e.clone(), e.clone()) } else { (edot.clone(), edot.clone()) };
-                    xp[d] += h;
-                    xm[d] -= h;
-                    let (mut qp, mut qm) = (vec![0.0; n], vec![0.0; n]);
-                    if which == 0 {
-                        contact.forces(&body, &kin, &xp, &edot, &mut qp, None);
-                        contact.forces(&body, &kin, &xm, &edot, &mut qm, None);
-                    } else {
-                        contact.forces(&body, &kin, &e, &xp, &mut qp, None);
-                        contact.forces(&body, &kin, &e, &xm, &mut qm, None);
-                    }
-                    for r in 0..n {
-                        let fd = (qp[r] - qm[r]) / (2.0 * h);
-                        worst = worst.max((fd - k[r * n + d]).abs());
-                    }
-                }
-                assert!(worst / scale < 1e-6, "{friction:?} {which}: {:.2e}", worst / scale);
-            }
+            assert_jacobians_match_fd(&contact, &body, &kin, &e, &edot, &jac, &format!("{friction:?}"));
         }
         // stored energy: d/ds U(e + s δ) = −(elastic contact force)·δ, damping off
         let (body, c, kin, e, _) = adhesive_setup(WallFriction::Frictionless);

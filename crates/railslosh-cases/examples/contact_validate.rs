@@ -11,7 +11,7 @@ fn main() {
                 println!("{r}");
             }
         }
-        Err(e @ railslosh_cases::contact::ValidationError::DataNotFound { .. }) => println!("skipped: {e}"),
+        Err(e) if e.is_data_not_found() => println!("skipped: {e}"),
         Err(e) => println!("error: {e}"),
     }
     println!("wall {:.2} s", t.elapsed().as_secs_f64());

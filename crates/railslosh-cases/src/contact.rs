@@ -10,7 +10,7 @@
 //! `manchester-contact-left` reads the CONTACT example files from the shared data directory
 //! ([`rail_mbs::wheel_rail::manchester`]: where it is searched, the readers, the contact pair
 //! and the frames). When the files are absent the case returns
-//! [`ValidationError::DataNotFound`]; the CLI and the Python tests report it as *skipped: data
+//! `ValidationError::Data(DataError::DataNotFound)`; the CLI and the Python tests report it as *skipped: data
 //! not found*, never as passed or failed.
 //!
 //! `quick` runs the integer shifts 0, 1, …, 10 mm (11 of the 21) with the
@@ -18,7 +18,7 @@
 //! shifts, also with Polach and FASTSIM, and a 1:20 and a 1:40 cone over five periods
 //! (quick: the 1:20 cone over two periods with a coarser RK4 step).
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use nalgebra::{Matrix3, Vector3};
 use thiserror::Error;
@@ -26,7 +26,7 @@ use thiserror::Error;
 use rail_mbs::profile::{Profile, ProfileError, uic60_rail};
 use rail_mbs::track::Side;
 use rail_mbs::wheel_rail::manchester::{
-    DATA_ENV, DataError, MANCHESTER_DIR, MANCHESTER_FILES, ManchesterReference, find_dataset, manchester_contact_pair,
+    DataError, MANCHESTER_DIR, MANCHESTER_FILES, ManchesterReference, find_dataset, manchester_contact_pair,
     parse_manchester_reference,
 };
 use rail_mbs::wheel_rail::static_load::{VerticalTarget, WheelState, solve_vertical};
@@ -40,54 +40,35 @@ use crate::Record;
 /// Names of the contact cases.
 pub const CASES: [&str; 2] = ["manchester-contact-left", "klingel-wavelength"];
 
-/// Errors of the contact validation cases.
+/// Errors of the contact validation cases: the data errors of
+/// [`rail_mbs::wheel_rail::manchester`] (a missing data set is
+/// `Data(DataError::DataNotFound)`: a skip, not a failure), or an unknown case.
 #[derive(Debug, Error)]
 pub enum ValidationError {
-    /// The external reference data are not available: the case is skipped, not failed.
-    #[error(
-        "data not found: `{dataset}` with {files} in none of [{searched}]; set {DATA_ENV} to the shared data directory",
-        files = required.join(", "),
-        searched = searched.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
-    )]
-    DataNotFound {
-        /// Folder name of the data set.
-        dataset: String,
-        /// Files it must hold.
-        required: Vec<String>,
-        /// Shared data directories searched.
-        searched: Vec<PathBuf>,
-    },
+    /// Reading the reference data, building the profiles or the contact failed.
+    #[error(transparent)]
+    Data(#[from] DataError),
     /// No case of that name.
     #[error("invalid `case` = {0:?}: expected one of {CASES:?}")]
     UnknownCase(String),
-    /// The reference data could not be read or parsed.
-    #[error("{file}: {message}")]
-    BadData {
-        /// File name.
-        file: String,
-        /// What is wrong.
-        message: String,
-    },
-    /// A profile could not be read or built.
-    #[error(transparent)]
-    Profile(#[from] ProfileError),
-    /// The contact computation failed.
-    #[error(transparent)]
-    Contact(#[from] ContactError),
 }
 
-/// The data errors keep their variant: a missing data set stays [`ValidationError::DataNotFound`]
-/// (a skip, not a failure).
-impl From<DataError> for ValidationError {
-    fn from(e: DataError) -> Self {
-        match e {
-            DataError::DataNotFound { dataset, required, searched } => {
-                Self::DataNotFound { dataset, required, searched }
-            }
-            DataError::BadData { file, message } => Self::BadData { file, message },
-            DataError::Profile(e) => Self::Profile(e),
-            DataError::Contact(e) => Self::Contact(e),
-        }
+impl ValidationError {
+    /// The reference data are absent: the case is skipped.
+    pub fn is_data_not_found(&self) -> bool {
+        matches!(self, Self::Data(DataError::DataNotFound { .. }))
+    }
+}
+
+impl From<ProfileError> for ValidationError {
+    fn from(e: ProfileError) -> Self {
+        Self::Data(e.into())
+    }
+}
+
+impl From<ContactError> for ValidationError {
+    fn from(e: ContactError) -> Self {
+        Self::Data(e.into())
     }
 }
 
@@ -141,7 +122,7 @@ fn manchester_compare(dir: &Path, cases: &[&ManchesterReference], model: CreepMo
     for c in cases {
         let pts = manchester_solve(&mut contact, c)?;
         if pts.is_empty() {
-            return Err(ValidationError::Contact(ContactError::InvalidInput(format!(
+            return Err(ValidationError::from(ContactError::InvalidInput(format!(
                 "no loaded contact point at y_ws = {} mm",
                 c.y_ws
             ))));
@@ -173,8 +154,9 @@ fn manchester_contact_left(quick: bool) -> Result<Vec<Record>, ValidationError> 
     let name = "manchester-contact-left";
     let dir = find_dataset(MANCHESTER_DIR, &MANCHESTER_FILES)?;
     let file = dir.join(MANCHESTER_FILES[0]);
-    let text = std::fs::read_to_string(&file)
-        .map_err(|e| ValidationError::BadData { file: file.display().to_string(), message: e.to_string() })?;
+    let text = std::fs::read_to_string(&file).map_err(|e| {
+        ValidationError::from(DataError::BadData { file: file.display().to_string(), message: e.to_string() })
+    })?;
     let all = parse_manchester_reference(&text, &file.display().to_string())?;
     // Quick: the integer shifts 0, 1, …, 10 mm.
     let cases: Vec<&ManchesterReference> =
@@ -261,9 +243,8 @@ fn cone_wheel_rail(side: Side, conicity: f64) -> Result<WheelRailContact, Valida
         })
         .collect();
     let rail = uic60_rail(2e-4)?;
-    let offset = RailGeometry::offset_for_gauge(&rail, 1.435, 0.014).ok_or_else(|| ValidationError::BadData {
-        file: "UIC60 (analytic)".into(),
-        message: "no gauge point".into(),
+    let offset = RailGeometry::offset_for_gauge(&rail, 1.435, 0.014).ok_or_else(|| {
+        ValidationError::from(DataError::BadData { file: "UIC60 (analytic)".into(), message: "no gauge point".into() })
     })?;
     let mut c = WheelRailContact::new(
         WheelGeometry {
@@ -300,7 +281,7 @@ fn cone_contact(
     let pose = WheelPose::at_rest(Vector3::new(x, y, KLINGEL_R0 - 1e-4), rot_z(psi));
     let g = c.find_geometry(&pose)?;
     let g = *g.iter().max_by(|a, b| a.penetration.total_cmp(&b.penetration)).ok_or_else(|| {
-        ValidationError::Contact(ContactError::InvalidInput(format!("no contact point at y = {y} m, yaw = {psi} rad")))
+        ValidationError::from(ContactError::InvalidInput(format!("no contact point at y = {y} m, yaw = {psi} rad")))
     })?;
     Ok((KLINGEL_R0 - conicity * g.params[2], g))
 }

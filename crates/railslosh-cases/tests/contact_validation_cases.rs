@@ -19,7 +19,7 @@ fn check(name: &str) {
             let failed: Vec<_> = records.iter().filter(|r| !r.passed).collect();
             assert!(failed.is_empty(), "{name}: failed records {failed:#?}");
         }
-        Err(e @ ValidationError::DataNotFound { .. }) => common::data_missing(&format!("{name}: {e}")),
+        Err(e) if e.is_data_not_found() => common::data_missing(&format!("{name}: {e}")),
         Err(e) => panic!("{name}: {e}"),
     }
 }

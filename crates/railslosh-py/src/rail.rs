@@ -106,7 +106,7 @@ fn contact_err(e: ContactError) -> PyErr {
 /// unknown case → `ValueError`, anything else → `RailsloshError`.
 fn validation_err(e: ValidationError) -> PyErr {
     match e {
-        ValidationError::DataNotFound { .. } => DataNotFoundError::new_err(e.to_string()),
+        e if e.is_data_not_found() => DataNotFoundError::new_err(e.to_string()),
         ValidationError::UnknownCase(_) => PyValueError::new_err(e.to_string()),
         other => RailsloshError::new_err(other.to_string()),
     }

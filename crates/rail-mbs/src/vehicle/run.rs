@@ -861,7 +861,10 @@ mod wheel_lift_tests {
         assert_eq!(k, 16);
         assert_eq!(e.cause(), crate::integrator::FailureCause::WheelOffRail);
         let m = e.to_string();
-        assert!(m.contains("wheel off the rail: wheelset 1") && m.contains("right wheel") && m.contains("0.0120 m"), "{m}");
+        assert!(
+            m.contains("wheel off the rail: wheelset 1") && m.contains("right wheel") && m.contains("0.0120 m"),
+            "{m}"
+        );
         assert!(m.contains("from t = 0.200 s to 0.320 s"), "{m}");
     }
 }
