@@ -624,7 +624,7 @@ def test_track_friction_reaches_the_runs_and_bad_tables_name_the_field():
     on the car's rail profile: a preset whose gauge face lies outside the profile is refused)."""
     doc = _set_dotted(BASE, "track.friction", {"preset": "lubricated_gauge_face", "mu_gauge": 0.05})
     sc = scene.load_scene(doc)
-    want = {"preset": "lubricated_gauge_face", "mu_top": 0.3, "mu_gauge": 0.05, "depth": 0.002, "width": 0.005}
+    want = {"preset": "lubricated_gauge_face", **railslosh._core.LUBRICATED_GAUGE_FACE, "mu_gauge": 0.05}
     assert sc.friction_map == want and sc.run_kwargs()["friction_map"] == want
     assert scene.load_scene(sc.to_dict()).friction_map == want
     assert scene.load_scene(BASE).run_kwargs()["friction_map"] is None

@@ -13,6 +13,7 @@ _Progress = Callable[[float, float, int, int, int], object]
 """Progress callback of the runs: ``(t, t_end, steps, newton_iterations, rejected_steps)``."""
 
 WALL_DAMPING_RATIO: float
+LUBRICATED_GAUGE_FACE: dict[str, float]
 GRAVITY: float
 FOOT: float
 INCH: float
@@ -265,7 +266,7 @@ class Profile:
     def trim_steep_ends(self, max_slope: float) -> Profile: ...
 
 def lubricated_gauge_face(
-    rail: Profile, *, mu_top: float = 0.4, mu_gauge: float = 0.1, depth: float = 0.002, width: float = 0.002
+    rail: Profile, *, mu_top: float = ..., mu_gauge: float = ..., depth: float = ..., width: float = ...
 ) -> list[tuple[float, float]]: ...
 def wheel_rail_contact(
     wheel: Profile,

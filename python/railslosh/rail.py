@@ -476,11 +476,17 @@ def contact(
 
 
 def lubricated_gauge_face(
-    rail: Profile, *, mu_top: float = 0.4, mu_gauge: float = 0.1, depth: float = 0.002, width: float = 0.002
+    rail: Profile,
+    *,
+    mu_top: float = _core.LUBRICATED_GAUGE_FACE["mu_top"],
+    mu_gauge: float = _core.LUBRICATED_GAUGE_FACE["mu_gauge"],
+    depth: float = _core.LUBRICATED_GAUGE_FACE["depth"],
+    width: float = _core.LUBRICATED_GAUGE_FACE["width"],
 ) -> list[tuple[float, float]]:
     """The ``friction_profile`` of a lubricated gauge face on ``rail`` (for :func:`contact`): ``mu_gauge``
     on the gauge side up to the point ``depth`` (m) below the rail top (2 mm: on UIC 60 about 25 mm to
-    the gauge side of the top), ``mu_top`` on the rest of the head, changing linearly over ``width`` (m)."""
+    the gauge side of the top), ``mu_top`` on the rest of the head, changing linearly over ``width`` (m).
+    Defaults: ``railslosh._core.LUBRICATED_GAUGE_FACE`` (``rail_mbs::wheel_rail::GaugeFaceLubrication``)."""
     return _core.lubricated_gauge_face(
         _core_profile(rail, "rail"),
         mu_top=_number(mu_top, "mu_top"),

@@ -170,9 +170,11 @@ def run(
 
     ``friction_map`` sets the wheel/rail friction over the rail profile and along the track
     (``rail_mbs::wheel_rail::FrictionMap``; default ``None``: ``car["friction"]`` everywhere): either
-    ``{"preset": "lubricated_gauge_face", "mu_top": 0.3, "mu_gauge": 0.1, "depth": 0.002, "width":
-    0.005}`` (``mu_gauge`` on the gauge face down from ``depth`` m below the rail top, blending to
-    ``mu_top`` over ``width`` m; the values shown are the defaults) or ``{"profile": [(v, mu), ...]}``
+    ``{"preset": "lubricated_gauge_face", "mu_top": 0.4, "mu_gauge": 0.1, "depth": 0.002, "width":
+    0.002}`` (``mu_gauge`` on the gauge face down from ``depth`` m below the rail top, blending to
+    ``mu_top`` over ``width`` m; the values shown are the defaults,
+    ``railslosh._core.LUBRICATED_GAUGE_FACE``, as :func:`railslosh.rail.lubricated_gauge_face`) or
+    ``{"profile": [(v, mu), ...]}``
     (μ over the rail profile's lateral coordinate v, m, as :func:`railslosh.rail.contact`), each with
     an optional ``"along_track": [(s, factor), ...]`` (a factor on μ over the distance s, m). Every
     contact patch takes the μ of its own place. The same in :func:`run_fluid` and

@@ -16,8 +16,8 @@ use pyo3::types::PyDict;
 use rail_mbs::profile::{self, Profile, ProfileError, ProfileKind};
 use rail_mbs::track::{INCH, Side, Track, TrackError, TrackPoint};
 use rail_mbs::wheel_rail::{
-    ContactError, CreepModel, Creepages, FrictionMap, Material, PatchModel, RailGeometry, RailPath, VerticalTarget,
-    WheelGeometry, WheelRailContact, WheelState, kik_piotrowski, solve_vertical,
+    ContactError, CreepModel, Creepages, FrictionMap, GaugeFaceLubrication, Material, PatchModel, RailGeometry,
+    RailPath, VerticalTarget, WheelGeometry, WheelRailContact, WheelState, kik_piotrowski, solve_vertical,
 };
 use railslosh_cases::contact::ValidationError;
 
@@ -888,7 +888,8 @@ pub fn wheel_rail_contact<'py>(
 /// lubricated_gauge_face`): `mu_gauge` on the gauge side up to the point `depth` (m) below the
 /// rail top, `mu_top` on the rest of the head, linear over `width` (m).
 #[pyfunction]
-#[pyo3(signature = (rail, *, mu_top=0.4, mu_gauge=0.1, depth=0.002, width=0.002))]
+#[pyo3(signature = (rail, *, mu_top=GaugeFaceLubrication::DEFAULT.mu_top, mu_gauge=GaugeFaceLubrication::DEFAULT.mu_gauge,
+                    depth=GaugeFaceLubrication::DEFAULT.depth, width=GaugeFaceLubrication::DEFAULT.width))]
 pub fn lubricated_gauge_face(
     rail: &PyProfile,
     mu_top: f64,
@@ -903,6 +904,12 @@ pub fn lubricated_gauge_face(
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("DataNotFoundError", m.py().get_type::<DataNotFoundError>())?;
+    let g = GaugeFaceLubrication::DEFAULT;
+    let d = PyDict::new(m.py());
+    for (k, v) in [("mu_top", g.mu_top), ("mu_gauge", g.mu_gauge), ("depth", g.depth), ("width", g.width)] {
+        d.set_item(k, v)?;
+    }
+    m.add("LUBRICATED_GAUGE_FACE", d)?;
     m.add_class::<PyTrack>()?;
     m.add_class::<PyProfile>()?;
     m.add_function(wrap_pyfunction!(wheel_rail_contact, m)?)?;

@@ -120,14 +120,17 @@ fn friction_map_of(
     };
     let preset: Option<String> = d.get_item("preset")?.map(|v| v.extract()).transpose()?;
     let mut map = match (preset.as_deref(), table("profile")?) {
-        (Some("lubricated_gauge_face"), None) => FrictionMap::lubricated_gauge_face(
-            rail,
-            num("mu_top", 0.3)?,
-            num("mu_gauge", 0.1)?,
-            num("depth", 0.002)?,
-            num("width", 0.005)?,
-        )
-        .map_err(err)?,
+        (Some("lubricated_gauge_face"), None) => {
+            let g = rail_mbs::wheel_rail::GaugeFaceLubrication::DEFAULT;
+            FrictionMap::lubricated_gauge_face(
+                rail,
+                num("mu_top", g.mu_top)?,
+                num("mu_gauge", g.mu_gauge)?,
+                num("depth", g.depth)?,
+                num("width", g.width)?,
+            )
+            .map_err(err)?
+        }
         (None, Some(profile)) => FrictionMap { profile, along_track: Vec::new() },
         (Some(p), None) => return Err(crate::to_py(invalid("friction_map.preset", p, "'lubricated_gauge_face'"))),
         _ => {

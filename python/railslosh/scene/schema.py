@@ -143,6 +143,8 @@ _WALL_DAMPING = Field(
     WALL_DAMPING_RATIO,
     PARAMETERS["wall_damping_ratio"],
 )
+_GAUGE_FACE = _core.LUBRICATED_GAUGE_FACE
+"""Defaults of the ``lubricated_gauge_face`` friction preset (``rail_mbs::wheel_rail::GaugeFaceLubrication``)."""
 _WALL_ADHESION = Field(
     "number",
     "suction the wall holds on the wetted liquid, in units of the hydrostatic pressure rho g H at the bottom "
@@ -195,12 +197,23 @@ SCHEMA: dict[str, dict[str, dict[str, Field]]] = {
                 "friction preset over the rail profile: mu_gauge on the gauge face, mu_top on the rest of the head "
                 "(railslosh.vehicle.run, friction_map); give it or `profile`",
             ),
-            "mu_top": _num(0.0, 1.0, "", "a friction coefficient", 0.3, "top-of-rail friction of the preset"),
-            "mu_gauge": _num(0.0, 1.0, "", "a friction coefficient", 0.1, "gauge-face friction of the preset"),
-            "depth": _num(
-                1e-4, 0.03, "m", "a depth", 0.002, "the preset's gauge face starts this far below the rail top"
+            "mu_top": _num(
+                0.0, 1.0, "", "a friction coefficient", _GAUGE_FACE["mu_top"], "top-of-rail friction of the preset"
             ),
-            "width": _num(1e-4, 0.05, "m", "a width", 0.005, "the preset's blend from mu_gauge to mu_top"),
+            "mu_gauge": _num(
+                0.0, 1.0, "", "a friction coefficient", _GAUGE_FACE["mu_gauge"], "gauge-face friction of the preset"
+            ),
+            "depth": _num(
+                1e-4,
+                0.03,
+                "m",
+                "a depth",
+                _GAUGE_FACE["depth"],
+                "the preset's gauge face starts this far below the rail top",
+            ),
+            "width": _num(
+                1e-4, 0.05, "m", "a width", _GAUGE_FACE["width"], "the preset's blend from mu_gauge to mu_top"
+            ),
             "profile": _value(
                 "[[v, mu], ...] (m, increasing v; 0 ≤ mu ≤ 1)",
                 "friction over the rail profile's lateral coordinate v (railslosh.rail.contact's friction_profile)",

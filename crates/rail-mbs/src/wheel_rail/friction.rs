@@ -37,6 +37,26 @@ fn invalid(field: &str, value: impl std::fmt::Display, allowed: &str) -> Contact
     ContactError::InvalidInput(ancf_core::error::invalid(field, value, allowed).to_string())
 }
 
+/// The parameters of [`FrictionMap::lubricated_gauge_face`]; [`Self::DEFAULT`] is the one
+/// home of their defaults (the contact API, vehicle runs and scenes read them from here).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GaugeFaceLubrication {
+    /// Friction on the top of the rail.
+    pub mu_top: f64,
+    /// Friction on the lubricated gauge face.
+    pub mu_gauge: f64,
+    /// The gauge face starts this far below the rail's highest point, m.
+    pub depth: f64,
+    /// Width of the blend from `mu_gauge` to `mu_top`, m.
+    pub width: f64,
+}
+
+impl GaugeFaceLubrication {
+    /// A dry top of rail (0.4), a greased gauge face (0.1) from 2 mm below the top, blended
+    /// over 2 mm.
+    pub const DEFAULT: Self = Self { mu_top: 0.4, mu_gauge: 0.1, depth: 0.002, width: 0.002 };
+}
+
 impl FrictionMap {
     /// The same μ everywhere.
     pub fn uniform(mu: f64) -> Result<Self, ContactError> {
