@@ -29,7 +29,7 @@ use rail_mbs::wheel_rail::manchester::{
     DataError, MANCHESTER_DIR, MANCHESTER_FILES, ManchesterReference, find_dataset, manchester_contact_pair,
     parse_manchester_reference,
 };
-use rail_mbs::wheel_rail::static_load::{VerticalTarget, WheelState, solve_vertical};
+use rail_mbs::wheel_rail::static_load::{VerticalTarget, solve_vertical};
 use rail_mbs::wheel_rail::{
     ContactError, ContactGeometry, ContactPoint, CreepModel, RailGeometry, RailPath, WheelGeometry, WheelPose,
     WheelRailContact,
@@ -91,15 +91,7 @@ fn manchester_solve(
     contact: &mut WheelRailContact,
     c: &ManchesterReference,
 ) -> Result<Vec<ContactPoint>, ContactError> {
-    let state = WheelState {
-        lateral_shift: -c.y_ws / 1000.0,
-        yaw: -c.yaw,
-        roll: c.roll,
-        speed: c.vx / 1000.0,
-        axle_rate: Some(-c.vpitch),
-        ..Default::default()
-    };
-    Ok(solve_vertical(contact, &state, VerticalTarget::Load(c.fz_total))?.points)
+    Ok(solve_vertical(contact, &c.wheel_state(), VerticalTarget::Load(c.fz_total))?.points)
 }
 
 /// Worst deviations of one creep law over the compared shifts.

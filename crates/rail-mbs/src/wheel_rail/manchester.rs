@@ -152,6 +152,21 @@ pub struct ManchesterReference {
     pub fz_total: f64,
 }
 
+impl ManchesterReference {
+    /// The wheel state of this case in this crate's frames (CONTACT's y, yaw and pitch rate
+    /// turned to ours; mm/s to m/s).
+    pub fn wheel_state(&self) -> WheelState {
+        WheelState {
+            lateral_shift: -self.y_ws / 1000.0,
+            yaw: -self.yaw,
+            roll: self.roll,
+            speed: self.vx / 1000.0,
+            axle_rate: Some(-self.vpitch),
+            ..Default::default()
+        }
+    }
+}
+
 fn numbers(line: &str) -> Vec<f64> {
     line.split_whitespace().filter_map(|t| t.parse::<f64>().ok()).collect()
 }
@@ -305,15 +320,7 @@ pub struct PatchCase {
 /// Solves case `c` with `contact` (its patch and creep models as set) at CONTACT's total
 /// vertical force and reads off [`PatchCase`].
 pub fn manchester_patch_case(contact: &mut WheelRailContact, c: &ManchesterReference) -> Result<PatchCase, DataError> {
-    let state = WheelState {
-        lateral_shift: -c.y_ws / 1000.0,
-        yaw: -c.yaw,
-        roll: c.roll,
-        speed: c.vx / 1000.0,
-        axle_rate: Some(-c.vpitch),
-        ..Default::default()
-    };
-    let loaded = solve_vertical(contact, &state, VerticalTarget::Load(c.fz_total))?;
+    let loaded = solve_vertical(contact, &c.wheel_state(), VerticalTarget::Load(c.fz_total))?;
     let pts = &loaded.points;
     let main = pts.iter().max_by(|a, b| a.normal_force.total_cmp(&b.normal_force)).ok_or_else(|| {
         DataError::Contact(ContactError::InvalidInput(format!("no loaded contact point at y_ws = {} mm", c.y_ws)))
