@@ -1122,6 +1122,30 @@ mod tests {
         }
     }
 
+    /// Stored energy: d/ds U(e + s δ) = −(elastic contact force)·δ for a random δ (seed
+    /// `seed`, entries up to 1 mm), by central differences of step `s` with the damping off,
+    /// to 1e-6 relative.
+    fn assert_stored_energy_is_the_elastic_potential(
+        c: &WallContact,
+        body: &FluidBody,
+        kin: &TankKinematics,
+        e: &[f64],
+        seed: u64,
+        s: f64,
+    ) {
+        let c0 = WallContact { law: WallContactLaw { damping: 0.0, ..c.law }, ..c.clone() };
+        let mut rng = Rng::new(seed);
+        let d: Vec<f64> = (0..e.len()).map(|_| rng.uniform() * 1e-3).collect();
+        let zero = vec![0.0; e.len()];
+        let mut f = vec![0.0; e.len()];
+        c0.forces(body, kin, e, &zero, &mut f, None);
+        let plus: Vec<f64> = e.iter().zip(&d).map(|(x, y)| x + s * y).collect();
+        let minus: Vec<f64> = e.iter().zip(&d).map(|(x, y)| x - s * y).collect();
+        let du = (c0.stored_energy(body, kin, &plus) - c0.stored_energy(body, kin, &minus)) / (2.0 * s);
+        let fd: f64 = f.iter().zip(&d).map(|(x, y)| x * y).sum();
+        assert!((du + fd).abs() < 1e-6 * fd.abs().max(1e-9), "dU = {du}, -F.d = {}", -fd);
+    }
+
     #[test]
     fn contact_jacobians_match_finite_differences() {
         for friction in [
@@ -1218,22 +1242,7 @@ mod tests {
             c.geometry.for_each_hit([p[0], p[1], p[2]], &c.node_sides[n], |h| d = d.max(h.psi));
             assert!(d <= b.depth + 1e-15, "node {n} is {d} deep, deeper than {b:?}");
         }
-        // stored energy: d/ds U(e + s δ) = −(elastic contact force)·δ, checked by central
-        // differences with the damping switched off
-        let mut law = c.law;
-        law.damping = 0.0;
-        let c0 = WallContact { law, ..c.clone() };
-        let mut rng = Rng::new(11);
-        let d: Vec<f64> = (0..e.len()).map(|_| rng.uniform() * 1e-3).collect();
-        let zero = vec![0.0; e.len()];
-        let mut f = vec![0.0; e.len()];
-        c0.forces(&body, &kin, &e, &zero, &mut f, None);
-        let s = 1e-4;
-        let plus: Vec<f64> = e.iter().zip(&d).map(|(x, y)| x + s * y).collect();
-        let minus: Vec<f64> = e.iter().zip(&d).map(|(x, y)| x - s * y).collect();
-        let du = (c0.stored_energy(&body, &kin, &plus) - c0.stored_energy(&body, &kin, &minus)) / (2.0 * s);
-        let fd: f64 = f.iter().zip(&d).map(|(x, y)| x * y).sum();
-        assert!((du + fd).abs() < 1e-6 * fd.abs().max(1e-9), "dU = {du}, -F.d = {}", -fd);
+        assert_stored_energy_is_the_elastic_potential(&c, &body, &kin, &e, 11, 1e-4);
         // a body far outside: reported, with an infinite depth for non-finite coordinates
         let mut nan = e.clone();
         nan[0] = f64::NAN;
@@ -1314,20 +1323,8 @@ mod tests {
             assert_eq!(load.force, full.force);
             assert_jacobians_match_fd(&contact, &body, &kin, &e, &edot, &jac, &format!("{friction:?}"));
         }
-        // stored energy: d/ds U(e + s δ) = −(elastic contact force)·δ, damping off
         let (body, c, kin, e, _) = adhesive_setup(WallFriction::Frictionless);
-        let c0 = WallContact { law: WallContactLaw { damping: 0.0, ..c.law }, ..c.clone() };
-        let mut rng = Rng::new(5);
-        let d: Vec<f64> = (0..e.len()).map(|_| rng.uniform() * 1e-3).collect();
-        let zero = vec![0.0; e.len()];
-        let mut f = vec![0.0; e.len()];
-        c0.forces(&body, &kin, &e, &zero, &mut f, None);
-        let s = 1e-5;
-        let plus: Vec<f64> = e.iter().zip(&d).map(|(x, y)| x + s * y).collect();
-        let minus: Vec<f64> = e.iter().zip(&d).map(|(x, y)| x - s * y).collect();
-        let du = (c0.stored_energy(&body, &kin, &plus) - c0.stored_energy(&body, &kin, &minus)) / (2.0 * s);
-        let fd: f64 = f.iter().zip(&d).map(|(x, y)| x * y).sum();
-        assert!((du + fd).abs() < 1e-6 * fd.abs().max(1e-9), "dU = {du}, -F.d = {}", -fd);
+        assert_stored_energy_is_the_elastic_potential(&c, &body, &kin, &e, 5, 1e-5);
         // nothing is beyond the walls by the containment check (it ignores the reach)
         assert!(c.containment(&body, &kin, &e).is_none_or(|b| b.depth < 0.003));
     }

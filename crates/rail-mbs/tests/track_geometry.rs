@@ -5,20 +5,9 @@ use nalgebra::Vector3;
 use rail_mbs::track::{FOOT, GRAVITY, INCH, Side, Track, TrackError, TrackPoint, curvature_from_degree};
 
 fn table1(cant_base: f64) -> Track {
-    // Seed 000, Table 1: distance (ft), curvature (deg), super-elevation (in), grade (%),
-    // right/left rail cant (rad).
-    let rows = [
-        (0.0, 0.0, 0.0),
-        (100.0, 0.0, 0.0),
-        (300.0, 3.0, 3.0),
-        (600.0, 3.0, 3.0),
-        (800.0, 0.0, 0.0),
-        (1000.0, 0.0, 0.0),
-        (1200.0, -3.0, -3.0),
-        (1500.0, -3.0, -3.0),
-        (1700.0, 0.0, 0.0),
-        (2800.0, 0.0, 0.0),
-    ];
+    // Seed 000, Table 1 (rail_mbs::track::presets): distance (ft), curvature (deg),
+    // super-elevation (in); grade 0, right/left rail cant 0.025/-0.025 rad.
+    let rows = rail_mbs::track::presets::TABLE1_ROWS;
     let pts = rows.iter().map(|&(d, c, e)| TrackPoint::from_us(d, c, e, 0.0, 0.025, -0.025)).collect();
     Track::with_options(pts, Track::STANDARD_GAUGE, cant_base, Vector3::zeros(), 0.0).expect("table 1 track")
 }

@@ -10,7 +10,7 @@ use ancf_core::error::{Result, invalid};
 use super::{FOOT, Track, TrackPoint};
 
 /// Seed 000 Table 1 track: (distance ft, curvature degrees, super-elevation in).
-const TABLE1_ROWS: [(f64, f64, f64); 10] = [
+pub const TABLE1_ROWS: [(f64, f64, f64); 10] = [
     (0.0, 0.0, 0.0),
     (100.0, 0.0, 0.0),
     (300.0, 3.0, 3.0),
