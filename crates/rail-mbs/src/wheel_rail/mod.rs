@@ -78,7 +78,7 @@ pub mod static_load;
 
 pub use contact::{
     ContactGeometry, ContactMethod, ContactPoint, ContactSettings, RailGeometry, RailPath, WheelGeometry, WheelPose,
-    WheelRailContact,
+    WheelRailContact, mirror_pseudovector, mirror_vector,
 };
 pub use creep::{
     CreepForces, CreepModel, Creepages, KalkerCoefficients, PatchStrip, creep_forces, fastsim_flexibilities,
