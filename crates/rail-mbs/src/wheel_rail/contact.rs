@@ -229,7 +229,13 @@ pub struct ContactSettings {
     pub newton_tolerance: f64,
     /// Maximum Newton iterations.
     pub max_iterations: usize,
-    /// Two solutions closer than this in both lateral parameters are merged, m.
+    /// Two solutions closer than this in both lateral parameters (rail `v`, wheel `u`) are
+    /// merged (the deeper one kept), m. This removes duplicates of one contact point (two scan
+    /// seeds converging to the same minimum of the gap); it is not a patch rule. Two distinct
+    /// minima of the gap stay two Hertzian points however close their patches lie, where
+    /// CONTACT (A_SEP, D_SEP, D_COMB; the Manchester benchmark input: 90°, 8 mm, 4 mm)
+    /// combines interpenetration regions whose facing ends lie within D_SEP into one patch
+    /// (docs/validation.md, "One patch or two: our rule and CONTACT's").
     pub merge_distance: f64,
     /// Scan every call (true, robust) or only when a warm start fails (false).
     pub always_scan: bool,
