@@ -2,10 +2,13 @@
 
 `manchester-contact-left` compares with CONTACT's reference output for the Manchester benchmark
 A2.2; it reads the data from the shared data directory and is skipped (never failed) when they
-are absent. `klingel-wavelength` is kinematic and needs no data.
+are absent. `klingel-wavelength` is kinematic and needs no data; nor do the four cases across the
+profile (issue 21: mirror symmetry, sweep refinement across the jumps, variable friction, Nadal
+flange climb), which run on the analytic S1002 wheel and UIC 60 rail.
 """
 
 import json
+import math
 import os
 import subprocess
 import sys
@@ -14,7 +17,14 @@ import pytest
 
 from railslosh import validate
 
-CONTACT_CASES = ["manchester-contact-left", "klingel-wavelength"]
+CONTACT_CASES = [
+    "manchester-contact-left",
+    "klingel-wavelength",
+    "contact-mirror-symmetry",
+    "contact-sweep-refinement",
+    "contact-variable-friction",
+    "contact-nadal-climb",
+]
 
 
 def run_cli(*args, env=None):
@@ -56,6 +66,24 @@ def test_klingel_is_labelled_kinematic_and_within_three_percent():
     assert "kinematic" in str(wave["quantity"])
     assert abs(wave["measured"] - wave["reference"]) <= 0.03 * wave["reference"]
     assert wave["tolerance"] == pytest.approx(0.03 * wave["reference"])
+
+
+def test_the_mirror_sweep_crosses_both_contact_point_jumps():
+    records = quick_records("contact-mirror-symmetry")
+    assert "201 shifts" in str(records[0]["quantity"])
+    jumps = next(r for r in records if "jumps" in str(r["quantity"]))
+    assert jumps["measured"] >= 2
+    for rec in records:
+        if "worst" in str(rec["quantity"]):
+            assert rec["tolerance"] == 1e-9
+
+
+def test_the_nadal_case_compares_with_nadal_at_70_degrees():
+    records = quick_records("contact-nadal-climb")
+    peak = next(r for r in records if "largest L/V" in str(r["quantity"]))
+    mu, tan = 0.3, math.tan(math.radians(70.0))
+    assert peak["reference"] == pytest.approx((tan - mu) / (1 + mu * tan), rel=1e-12)
+    assert peak["tolerance"] == pytest.approx(2e-3 * peak["reference"])
 
 
 def test_cli_json_for_the_manchester_case():

@@ -67,7 +67,8 @@ _DESCRIPTIONS = {
     "f1 from zero crossings of the raw load change <= 5 % between the two finest of three meshes and two step sizes; "
     "raw zero-crossing frequency within 3 % of the spectral peak (no chatter)",
     "manchester-contact-left": "Manchester contact benchmark A2.2, left wheel (S1002 on UIC60 1:40, 10 kN, shifts "
-    "0-10 mm) vs CONTACT: contact position, normal force, creep forces (needs shared data)",
+    "0-10 mm) vs CONTACT: contact position, normal force, creep forces; full form also Polach, FASTSIM and the "
+    "Kik-Piotrowski patch (needs shared data)",
     "static-wheel-loads": "68-DOF tank car (36 t rigid lading) settles on tangent track: every wheel load equals "
     "its static share within 1 %, no drift",
     "balance-speed-curving": "tank car on a 1000 m curve (balance speed 60 km/h): outer/inner wheel loads equal "
@@ -86,6 +87,17 @@ _DESCRIPTIONS = {
     "coupler force, its RMS and steady mean change <= 5 % between the two finest of three meshes and two steps",
     "klingel-wavelength": "kinematic (no-slip) free coned wheelset: lateral oscillation wavelength vs Klingel's "
     "2 pi sqrt(r0 b / lambda)",
+    "contact-mirror-symmetry": "S1002 on UIC60 1:40, 60 kN: the right wheel at shift y, yaw, roll equals the mirrored "
+    "left wheel at -y, -yaw, -roll to 1e-9 (forces, moments, normal forces), 201 shifts -10..+10 mm across the "
+    "contact-point jumps (quick: one yaw/roll pose, full: three)",
+    "contact-sweep-refinement": "S1002 on UIC60 1:40, 60 kN, swept 0-10 mm towards the flange in steps down to "
+    "0.05 mm with the search warm-started: contact points equal a fresh search's, jump locations nest as the step "
+    "is refined (quick: left wheel, 0.5 and 0.25 mm)",
+    "contact-variable-friction": "S1002 on UIC60 1:40, lubricated gauge face (mu 0.1) and dry top (mu 0.4): each "
+    "patch of a two-point contact saturates at the mu of its own location; uniform map = scalar friction",
+    "contact-nadal-climb": "S1002 on UIC60 1:40, 50 kN, saturated lateral creepage: in flange contact L/V equals "
+    "Nadal's (tan d - mu)/(1 + mu tan d) at each contact angle and peaks at Nadal's limit at 70 deg "
+    "(quick: mu 0.3; full: mu 0.3 and 0.5)",
 }
 
 CASES: dict[str, Case] = {

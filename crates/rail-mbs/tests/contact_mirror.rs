@@ -1,15 +1,20 @@
 //! Mirror symmetry of the wheel/rail contact (issue 21): with the same (symmetric) profiles on
 //! both sides, the right wheel at lateral shift y, yaw ψ and roll φ is the mirror image of the
-//! left wheel at −y, −ψ, −φ. The mapping, written once: the reflection M = diag(1, −1, 1) of the
-//! track's lateral axis maps positions and forces as x → M x, rotations as R → M R M, the
-//! angular velocity (a pseudovector) as ω → −M ω, and moments (pseudovectors) as m → −M m.
+//! left wheel at −y, −ψ, −φ. The mapping is written once, in the library
+//! (`WheelPose::mirrored`, `mirror_vector`, `mirror_pseudovector`): the reflection
+//! M = diag(1, −1, 1) of the track's lateral axis maps positions and forces as x → M x,
+//! rotations as R → M R M, the angular velocity (a pseudovector) as ω → −M ω, and moments
+//! (pseudovectors) as m → −M m. The validation case `contact-mirror-symmetry`
+//! (`railslosh_cases::contact`) runs the same sweep.
 
 use nalgebra::{Matrix3, Vector3};
 use rail_mbs::profile::{s1002_wheel, uic60_rail};
 use rail_mbs::track::Side;
 mod common;
 use common::contact::{height_for_load, s1002_on_uic60};
-use rail_mbs::wheel_rail::{RailGeometry, RailPath, WheelGeometry, WheelPose, WheelRailContact};
+use rail_mbs::wheel_rail::{
+    RailGeometry, RailPath, WheelGeometry, WheelPose, WheelRailContact, mirror_pseudovector, mirror_vector,
+};
 
 fn contact(side: Side) -> WheelRailContact {
     let mut c = s1002_on_uic60(side, RailPath::Straight { inward_cant: 1.0 / 40.0 });
@@ -21,17 +26,6 @@ fn rot(yaw: f64, roll: f64) -> Matrix3<f64> {
     let (sz, cz) = yaw.sin_cos();
     let (sx, cx) = roll.sin_cos();
     Matrix3::new(cz, -sz, 0.0, sz, cz, 0.0, 0.0, 0.0, 1.0) * Matrix3::new(1.0, 0.0, 0.0, 0.0, cx, -sx, 0.0, sx, cx)
-}
-
-/// The mirror image of a pose (module docs).
-fn mirror(p: &WheelPose) -> WheelPose {
-    let m = Matrix3::from_diagonal(&Vector3::new(1.0, -1.0, 1.0));
-    WheelPose {
-        position: m * p.position,
-        rotation: m * p.rotation * m,
-        velocity: m * p.velocity,
-        angular_velocity: -(m * p.angular_velocity),
-    }
 }
 
 /// Contact points that the search could only approximate (scan fall-backs).
@@ -56,7 +50,6 @@ fn resultant(c: &mut WheelRailContact, pose: &WheelPose) -> (Vector3<f64>, Vecto
 #[test]
 fn the_right_wheel_is_the_mirror_image_of_the_left_wheel_over_a_sweep_of_shifts() {
     let (mut left, mut right) = (contact(Side::Left), contact(Side::Right));
-    let m = Matrix3::from_diagonal(&Vector3::new(1.0, -1.0, 1.0));
     let (v, r0) = (20.0, 0.46);
     let mut worst: f64 = 0.0;
     let mut cases = 0;
@@ -74,14 +67,14 @@ fn the_right_wheel_is_the_mirror_image_of_the_left_wheel_over_a_sweep_of_shifts(
             // the left wheel carrying 60 kN (the mirrored right wheel is then at that height too)
             pose.position.z = height_for_load(&mut left, &pose, 6e4, 0.02);
             let (fl, ml, nl) = resultant(&mut left, &pose);
-            let mp = mirror(&pose);
+            let mp = pose.mirrored();
             let (fr, mr, nr) = resultant(&mut right, &mp);
             *counts.entry(nl.len()).or_insert(0) += 1;
             assert!(!nl.is_empty(), "the wheel touches the rail");
             assert_eq!(nl.len(), nr.len(), "contact-point count at y = {y}, yaw {yaw}, roll {roll}");
             let scale = fl.norm().max(1.0);
-            let ef = (fr - m * fl).norm() / scale;
-            let em = (mr + m * ml).norm() / (ml.norm().max(1.0));
+            let ef = (fr - mirror_vector(&fl)).norm() / scale;
+            let em = (mr - mirror_pseudovector(&ml)).norm() / (ml.norm().max(1.0));
             let en = nl.iter().zip(&nr).map(|(a, b)| (a - b).abs() / scale).fold(0.0, f64::max);
             worst = worst.max(ef).max(em).max(en);
             assert!(

@@ -50,6 +50,18 @@ impl Record {
             passed: measured.is_finite() && measured.abs() <= limit,
         }
     }
+    /// Check measured ≥ limit (signed; the limit is reported as the reference, with a zero
+    /// tolerance).
+    pub fn at_least(case: &str, quantity: impl Into<String>, measured: f64, limit: f64) -> Self {
+        Self {
+            case: case.into(),
+            quantity: quantity.into(),
+            measured,
+            reference: limit,
+            tolerance: 0.0,
+            passed: measured.is_finite() && measured >= limit,
+        }
+    }
     /// Check measured < limit (signed; the limit is reported as the reference, with a zero
     /// tolerance).
     pub fn less_than(case: &str, quantity: impl Into<String>, measured: f64, limit: f64) -> Self {

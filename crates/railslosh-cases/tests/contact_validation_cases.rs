@@ -35,6 +35,26 @@ fn klingel_wavelength_quick() {
 }
 
 #[test]
+fn contact_mirror_symmetry_quick() {
+    check("contact-mirror-symmetry");
+}
+
+#[test]
+fn contact_sweep_refinement_quick() {
+    check("contact-sweep-refinement");
+}
+
+#[test]
+fn contact_variable_friction_quick() {
+    check("contact-variable-friction");
+}
+
+#[test]
+fn contact_nadal_climb_quick() {
+    check("contact-nadal-climb");
+}
+
+#[test]
 fn every_case_is_dispatched() {
     for name in CASES {
         assert!(!matches!(run_case(name, true), Err(ValidationError::UnknownCase(_))));

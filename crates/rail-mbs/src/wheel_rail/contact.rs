@@ -187,6 +187,35 @@ impl WheelPose {
     pub fn at_rest(position: Vector3<f64>, rotation: Matrix3<f64>) -> Self {
         Self { position, rotation, velocity: Vector3::zeros(), angular_velocity: Vector3::zeros() }
     }
+
+    /// The mirror image of this pose in the track's vertical centre plane (global `y → −y`):
+    /// the pose of the other side's wheel, with the same (symmetric) profiles, that is the
+    /// mirror image of this one (a right wheel at shift `y`, yaw `ψ`, roll `φ` mirrors a left
+    /// wheel at `−y`, `−ψ`, `−φ`). With the reflection `M = diag(1, −1, 1)`, positions and
+    /// velocities map as `x → M x` ([`mirror_vector`]), rotations as `R → M R M`, and the
+    /// angular velocity, a pseudovector, as `ω → −M ω` ([`mirror_pseudovector`]). Forces of
+    /// the mirrored contact are then `M F`, moments `−M m`.
+    pub fn mirrored(&self) -> Self {
+        let m = Matrix3::from_diagonal(&Vector3::new(1.0, -1.0, 1.0));
+        Self {
+            position: mirror_vector(&self.position),
+            rotation: m * self.rotation * m,
+            velocity: mirror_vector(&self.velocity),
+            angular_velocity: mirror_pseudovector(&self.angular_velocity),
+        }
+    }
+}
+
+/// A (polar) vector — position, velocity, force — reflected in the track's vertical centre
+/// plane: `M v` with `M = diag(1, −1, 1)` ([`WheelPose::mirrored`]).
+pub fn mirror_vector(v: &Vector3<f64>) -> Vector3<f64> {
+    Vector3::new(v.x, -v.y, v.z)
+}
+
+/// A pseudovector — angular velocity, moment — reflected in the track's vertical centre
+/// plane: `−M m` with `M = diag(1, −1, 1)` ([`WheelPose::mirrored`]).
+pub fn mirror_pseudovector(m: &Vector3<f64>) -> Vector3<f64> {
+    Vector3::new(-m.x, m.y, -m.z)
 }
 
 /// Settings of the contact search and force evaluation.
@@ -200,7 +229,13 @@ pub struct ContactSettings {
     pub newton_tolerance: f64,
     /// Maximum Newton iterations.
     pub max_iterations: usize,
-    /// Two solutions closer than this in both lateral parameters are merged, m.
+    /// Two solutions closer than this in both lateral parameters (rail `v`, wheel `u`) are
+    /// merged (the deeper one kept), m. This removes duplicates of one contact point (two scan
+    /// seeds converging to the same minimum of the gap); it is not a patch rule. Two distinct
+    /// minima of the gap stay two Hertzian points however close their patches lie, where
+    /// CONTACT (A_SEP, D_SEP, D_COMB; the Manchester benchmark input: 90°, 8 mm, 4 mm)
+    /// combines interpenetration regions whose facing ends lie within D_SEP into one patch
+    /// (docs/validation.md, "One patch or two: our rule and CONTACT's").
     pub merge_distance: f64,
     /// Scan every call (true, robust) or only when a warm start fails (false).
     pub always_scan: bool,

@@ -46,6 +46,14 @@
 //!   ([`ContactSettings::min_relative_curvature`]); a genuinely conformal contact (one
 //!   wide patch, as CONTACT finds for S1002/UIC60 at zero lateral shift) is represented by
 //!   two Hertzian points instead.
+//! * One point per minimum of the gap: solutions within [`ContactSettings::merge_distance`]
+//!   (1 mm in both lateral parameters) are one point found twice and are merged; distinct
+//!   minima are never combined into one patch. CONTACT decides between one patch and two on
+//!   the interpenetration regions instead: regions whose contact angles differ by at most
+//!   A_SEP and whose facing ends lie within D_SEP are one patch (fully merged within D_COMB,
+//!   between D_COMB and D_SEP one patch of two weakly coupled parts). On S1002/UIC 60 at 1:40
+//!   every two-point contact we find is one patch by CONTACT's rule (docs/validation.md, "One
+//!   patch or two: our rule and CONTACT's").
 //! * Rails following a [`crate::track::Track`] get the first and second derivatives of
 //!   their frame along `s` by central differences (2 cm), the track's irregularity
 //!   ([`crate::track::Irregularity`], a translation of each rail's profile) included;
@@ -78,7 +86,7 @@ pub mod static_load;
 
 pub use contact::{
     ContactGeometry, ContactMethod, ContactPoint, ContactSettings, RailGeometry, RailPath, WheelGeometry, WheelPose,
-    WheelRailContact,
+    WheelRailContact, mirror_pseudovector, mirror_vector,
 };
 pub use creep::{
     CreepForces, CreepModel, Creepages, KalkerCoefficients, PatchStrip, creep_forces, fastsim_flexibilities,
