@@ -589,7 +589,7 @@ impl WheelRailContact {
         let a = mt * pose.rotation.column(0);
         let b = mt * pose.rotation.column(2);
         let cl = mt * (centre - fd.origin);
-        let th = (-a.z).atan2(b.z);
+        let th = Self::lowest_angle(pose, fd);
         let rho = self.wheel.nominal_radius - self.wheel.profile.z(u);
         (cl + (a * th.sin() - b * th.cos()) * rho, th)
     }
@@ -731,10 +731,31 @@ impl WheelRailContact {
         self.scan_gap(pose, s0, &frame, 0.5 * (a + b)).1
     }
 
-    fn in_domain(&self, q: &[f64; 4]) -> bool {
+    /// Whether Newton's solution `q` lies on both profiles and within 0.5 rad of the wheel
+    /// circle's lowest point. The wheel angle `θ = q[3]` is measured in the wheel's body frame,
+    /// which turns with the wheel as it rolls, so the bound applies to θ relative to the lowest
+    /// point's angle at the pose (wrapped to ±π), not to θ itself: a bound on θ itself rejected
+    /// every converged solution of a rolling wheel whose spin angle was beyond ±0.5 rad (about
+    /// three quarters of the evaluations of a running car), and the search then took the
+    /// scan's fall-back point under the wheel centre instead of the contact point.
+    fn in_domain(&self, pose: &WheelPose, q: &[f64; 4]) -> bool {
         let (rl, rh) = self.rail.profile.y_range();
         let (wl, wh) = self.wheel.profile.y_range();
-        q.iter().all(|x| x.is_finite()) && q[1] >= rl && q[1] <= rh && q[2] >= wl && q[2] <= wh && q[3].abs() < 0.5
+        if !(q.iter().all(|x| x.is_finite()) && q[1] >= rl && q[1] <= rh && q[2] >= wl && q[2] <= wh) {
+            return false;
+        }
+        let lowest = Self::lowest_angle(pose, &self.rail.frame_derivs(q[0]));
+        let rel = (q[3] - lowest + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+        rel.abs() < 0.5
+    }
+
+    /// The wheel angle θ (body frame) of the lowest point of the wheel's circles in the rail
+    /// frame `fd`.
+    fn lowest_angle(pose: &WheelPose, fd: &RailFrameDerivs) -> f64 {
+        let mt = fd.rot.transpose();
+        let a = mt * pose.rotation.column(0);
+        let b = mt * pose.rotation.column(2);
+        (-a.z).atan2(b.z)
     }
 
     /// Finds all potential contact points (local minima of the gap with a vertical gap
@@ -760,7 +781,7 @@ impl WheelRailContact {
             let mut ok = true;
             for k in 0..self.previous.len() {
                 match self.newton(pose, self.previous[k]) {
-                    Ok(q) if self.in_domain(&q) => out.push(self.geometry_at(pose, q, ContactMethod::Newton)),
+                    Ok(q) if self.in_domain(pose, &q) => out.push(self.geometry_at(pose, q, ContactMethod::Newton)),
                     _ => {
                         ok = false;
                         break;
@@ -783,7 +804,7 @@ impl WheelRailContact {
             // a Newton solution from `from` that stays in the domain near this seed, and its
             // geometry when both relative curvatures are positive
             let converged = |from: [f64; 4]| {
-                self.newton(pose, from).ok().filter(|q| self.in_domain(q) && (q[2] - seed[2]).abs() < 5e-3)
+                self.newton(pose, from).ok().filter(|q| self.in_domain(pose, q) && (q[2] - seed[2]).abs() < 5e-3)
             };
             let convex = |q: [f64; 4]| {
                 Some(self.geometry_at(pose, q, ContactMethod::Newton))
