@@ -1189,3 +1189,45 @@ fn extrapolating_predictor_is_exact_for_linearly_growing_accelerations() {
     let exact = c * t.powi(3) / (6.0 * m);
     assert!((x_extra - exact).abs() < 1e-3 * exact, "{x_extra} vs {exact}");
 }
+
+#[test]
+fn stepping_to_output_times_lands_on_them_without_slivers() {
+    // A run loop that records every 0.02 s with steps of at most 4 ms, to 14 s (the vehicle
+    // runs' pattern). With plain steps of min(h, target - t) the time accumulates round-off and
+    // falls short of an output time by more than the loop's 1e-12 s tolerance: the loop then asks
+    // for a step of ~1e-12 s (a vehicle run on irregular track stopped at 13.1 s that way).
+    let (dt_out, h, n_out): (f64, f64, usize) = (0.02, 0.004, 700);
+    let start = || {
+        let sys = Pendulum::new();
+        let (q0, v0) = sys.start(0.3);
+        Hht::new(sys, 0.0, q0, v0, HhtParams::default()).unwrap()
+    };
+    let mut plain = start();
+    let mut smallest_plain = f64::INFINITY;
+    let mut plain_error = None;
+    'outputs: for k in 1..=n_out {
+        let target = k as f64 * dt_out;
+        while plain.t() < target - 1e-12 {
+            let request = h.min(target - plain.t());
+            smallest_plain = smallest_plain.min(request);
+            if let Err(e) = plain.step(request) {
+                plain_error = Some(e);
+                break 'outputs;
+            }
+        }
+    }
+    let mut hht = start();
+    let mut smallest = f64::INFINITY;
+    for k in 1..=n_out {
+        let target = k as f64 * dt_out;
+        while hht.t() < target - 1e-12 {
+            smallest = smallest.min(hht.step_toward(target, h).unwrap().h);
+        }
+        assert_eq!(hht.t(), target, "output {k} not landed on exactly");
+    }
+    eprintln!("smallest request: plain {smallest_plain:.3e} s ({plain_error:?}), step_toward {smallest:.3e} s");
+    // the plain loop asks for a sliver, and the step after it diverges (fixed steps here)
+    assert!(smallest_plain < 1e-9, "the plain loop leaves no sliver here ({smallest_plain:e}): the test shows nothing");
+    assert!(plain_error.is_some());
+    assert!(smallest > 0.999 * h, "step_toward took a step of {smallest:e} s");
+}

@@ -563,7 +563,7 @@ pub(crate) fn step_and_record<S: crate::integrator::MechanicalSystem>(
         let t_prev = if k == 0 { 0.0 } else { ((k - 1) as f64 * sc.record_every).min(sc.t_end) };
         let target = (k as f64 * sc.record_every).min(sc.t_end);
         while hht.t() < target - 1e-12 {
-            let stepped = hht.step(sc.step.min(target - hht.t())).map(|_| ()).and_then(|_| {
+            let stepped = hht.step_toward(target, sc.step).map(|_| ()).and_then(|_| {
                 if filtered {
                     record(hht, RecordEvent::Loads(&mut buf))?;
                     hat.step(t_prev, target, hht.t(), buf.clone());
