@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from railslosh import _core
 from railslosh.limits import invalid
 
 __all__ = [
@@ -286,8 +287,7 @@ def nadal_limit(flange_angle: float = 70.0, friction: float = NADAL_FRICTION) ->
     if d >= 90.0:
         raise invalid("flange_angle", flange_angle, "an angle in degrees > 0 and < 90")
     mu = _positive("friction", friction, "a friction coefficient", zero=True)
-    tan = math.tan(math.radians(d))
-    return (tan - mu) / (1.0 + mu * tan)
+    return _core.nadal_limit(math.radians(d), mu)
 
 
 def wheel_profile(ds: Any) -> str:

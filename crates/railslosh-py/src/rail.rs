@@ -902,6 +902,13 @@ pub fn lubricated_gauge_face(
         .map_err(contact_err)
 }
 
+/// Nadal's flange-climb limit (tan δ − μ)/(1 + μ tan δ) for contact angle δ (rad) and friction μ
+/// (`rail_mbs::wheel_rail::nadal_limit`).
+#[pyfunction]
+fn nadal_limit(contact_angle: f64, friction: f64) -> f64 {
+    rail_mbs::wheel_rail::nadal_limit(contact_angle, friction)
+}
+
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("DataNotFoundError", m.py().get_type::<DataNotFoundError>())?;
     let g = GaugeFaceLubrication::DEFAULT;
@@ -914,5 +921,6 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyProfile>()?;
     m.add_function(wrap_pyfunction!(wheel_rail_contact, m)?)?;
     m.add_function(wrap_pyfunction!(lubricated_gauge_face, m)?)?;
+    m.add_function(wrap_pyfunction!(nadal_limit, m)?)?;
     Ok(())
 }

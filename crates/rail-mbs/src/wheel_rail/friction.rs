@@ -119,6 +119,16 @@ impl FrictionMap {
     }
 }
 
+/// Nadal's flange-climb limit `Y/Q = (tan δ − μ) / (1 + μ tan δ)` (M. J. Nadal, 1908): the
+/// single-wheel L/V at which a wheel in contact at angle `contact_angle` δ (rad) with friction
+/// `friction` μ starts to climb the rail (saturated creep pointing down the flange). The one
+/// implementation: the derailment indicators (Python `railslosh.indicators.nadal_limit`) and the
+/// flange-climb validation case call it.
+pub fn nadal_limit(contact_angle: f64, friction: f64) -> f64 {
+    let t = contact_angle.tan();
+    (t - friction) / (1.0 + friction * t)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -92,7 +92,7 @@ pub use creep::{
     CreepForces, CreepModel, Creepages, KalkerCoefficients, PatchStrip, creep_forces, fastsim_flexibilities,
     fastsim_strips, kalker_coefficients, linear_coefficients,
 };
-pub use friction::{FrictionMap, GaugeFaceLubrication};
+pub use friction::{FrictionMap, GaugeFaceLubrication, nadal_limit};
 pub use hertz::{HertzConstants, Material, combined_modulus, elliptic_ke};
 pub use kik_piotrowski::{KpPatch, PatchModel, PatchSummary, QuadraticSeparation, SampledSeparation, SeparationFn};
 pub use static_load::{LoadedContact, VerticalTarget, WheelState, apply_creepages, solve_vertical};

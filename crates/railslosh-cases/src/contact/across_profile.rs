@@ -13,7 +13,8 @@ use rail_mbs::track::Side;
 use rail_mbs::wheel_rail::manchester::DataError;
 use rail_mbs::wheel_rail::{
     ContactError, ContactMethod, ContactPoint, Creepages, FrictionMap, RailGeometry, RailPath, VerticalTarget,
-    WheelGeometry, WheelPose, WheelRailContact, WheelState, mirror_pseudovector, mirror_vector, solve_vertical,
+    WheelGeometry, WheelPose, WheelRailContact, WheelState, mirror_pseudovector, mirror_vector, nadal_limit,
+    solve_vertical,
 };
 
 use super::ValidationError;
@@ -472,12 +473,6 @@ pub(super) fn variable_friction(quick: bool) -> Result<Vec<Record>, ValidationEr
 // Nadal flange climb, quasi-static
 // ---------------------------------------------------------------------------------------
 
-/// Nadal's flange-climb limit `(tan δ − μ) / (1 + μ tan δ)` (δ in rad).
-fn nadal(delta: f64, mu: f64) -> f64 {
-    let t = delta.tan();
-    (t - mu) / (1.0 + mu * t)
-}
-
 /// The flange angle of S1002, rad.
 const S1002_FLANGE_ANGLE: f64 = 70.0 * std::f64::consts::PI / 180.0;
 
@@ -515,7 +510,7 @@ pub(super) fn nadal_climb(quick: bool) -> Result<Vec<Record>, ValidationError> {
             let lv = -l.points.iter().map(|p| p.force_on_wheel().y).sum::<f64>() / l.vertical_force;
             if delta > 45f64.to_radians() {
                 flange_points += 1;
-                worst = worst.max((lv - nadal(delta, mu)).abs() / nadal(delta, mu));
+                worst = worst.max((lv - nadal_limit(delta, mu)).abs() / nadal_limit(delta, mu));
             }
             if lv > peak.0 {
                 peak = (lv, delta);
@@ -546,7 +541,7 @@ pub(super) fn nadal_climb(quick: bool) -> Result<Vec<Record>, ValidationError> {
             S1002_FLANGE_ANGLE.to_degrees(),
             0.15,
         ));
-        let reference = nadal(S1002_FLANGE_ANGLE, mu);
+        let reference = nadal_limit(S1002_FLANGE_ANGLE, mu);
         out.push(Record::abs(
             name,
             format!("{what}: largest L/V (climb) vs Nadal's limit at 70 deg, tolerance 0.2 % relative"),
