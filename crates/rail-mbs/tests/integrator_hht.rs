@@ -1230,4 +1230,11 @@ fn stepping_to_output_times_lands_on_them_without_slivers() {
     assert!(smallest_plain < 1e-9, "the plain loop leaves no sliver here ({smallest_plain:e}): the test shows nothing");
     assert!(plain_error.is_some());
     assert!(smallest > 0.999 * h, "step_toward took a step of {smallest:e} s");
+    // An output time a sliver more than one step away (an adaptive step of 2.99999979 ms left
+    // 2.00000021 ms in a vehicle run): one step of h would leave 2.1e-10 s; step_toward takes
+    // the remainder in one step.
+    let target = hht.t() + h + 2.1e-10;
+    let info = hht.step_toward(target, h).unwrap();
+    assert_eq!(hht.t(), target);
+    assert!(info.h > h && info.h < 1.0001 * h, "{}", info.h);
 }
