@@ -39,3 +39,26 @@ def test_rigid_and_equivalent_models_agree_in_wheel_load_rms_on_an_irregular_tra
     ratio = q_equivalent / q_rigid
     print("equivalent / rigid wheel-load RMS per wheel:", np.round(ratio.ravel(), 4))
     assert np.all(np.abs(ratio - 1.0) < 0.05), ratio
+
+
+def test_the_empty_car_rides_within_sperlings_running_range_on_class_5_track_at_100_kmh():
+    """Issue 20 (dynamics): the empty tank car driven at 100 km/h over FRA class 5 vertical profile
+    (1-70 m, from 70 m with a 30 m taper, seed 1). Sperling's ride index Wz of the tank's vertical
+    acceleration after 1.5 s must lie on the part of Sperling's scale where freight cars run: from
+    3 ("satisfactory") to 4.5 ("not acceptable for running"); 4 is "still acceptable for running".
+    Measured 2026-11-26: 4.03 (2.59 at 60 km/h). An empty freight car rides worse than a loaded
+    one; this run had stopped at 3.48 s on a 2.1e-10 s step before ``Hht::step_toward`` took such
+    remainders in one step, and the contact search's fall-back points had damped it to 3.39."""
+    from railslosh import indicators
+
+    v = 100 / 3.6
+    irr = irregularity.generate("fra", 5, length=v * 8.0 + 100.0, start=70.0, taper=30.0, channels=["vertical"])
+    res = vehicle.run(
+        TANGENT, cars=1, station=50.0, speed=v, t_end=8.0, step=2e-3, record_every=0.005, drive=True, irregularity=irr
+    )
+    t = np.asarray(res["t"])
+    a = np.asarray(res["car_acceleration"])[:, 0, :]
+    m = t >= 1.5
+    wz = indicators.sperling_wz(t[m], a[m, 2], "vertical")
+    print(f"Wz vertical {wz:.3f}")
+    assert 3.0 <= wz <= 4.5, wz
