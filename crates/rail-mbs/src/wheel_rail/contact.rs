@@ -586,10 +586,9 @@ impl WheelRailContact {
         let mt = fd.rot.transpose();
         let w0 = self.wheel.surface(u, 0.0);
         let centre = pose.position + pose.rotation * Vector3::new(0.0, w0[0].y, 0.0);
-        let a = mt * pose.rotation.column(0);
-        let b = mt * pose.rotation.column(2);
+        let (a, b) = Self::wheel_axes(pose, fd);
         let cl = mt * (centre - fd.origin);
-        let th = Self::lowest_angle(pose, fd);
+        let th = Self::lowest_angle(&a, &b);
         let rho = self.wheel.nominal_radius - self.wheel.profile.z(u);
         (cl + (a * th.sin() - b * th.cos()) * rho, th)
     }
@@ -687,15 +686,15 @@ impl WheelRailContact {
         &self,
         pose: &WheelPose,
         s0: f64,
+        fd: &RailFrameDerivs,
         vals: &mut Vec<(f64, [f64; 4])>,
         seeds: &mut Vec<(f64, [f64; 4], f64, f64)>,
     ) {
         let (lo, hi) = self.wheel.profile.y_range();
         let n = self.settings.scan_points.max(8);
         let u = |i: usize| lo + (hi - lo) * i as f64 / (n - 1) as f64;
-        let fd = self.rail.frame_derivs(s0);
         vals.clear();
-        vals.extend((0..n).map(|i| self.scan_gap(pose, s0, &fd, u(i))));
+        vals.extend((0..n).map(|i| self.scan_gap(pose, s0, fd, u(i))));
         seeds.clear();
         for i in 1..n - 1 {
             let g = vals[i].0;
@@ -706,10 +705,9 @@ impl WheelRailContact {
     }
 
     /// Golden-section refinement of the scan gap on `[a, b]` (fallback).
-    fn refine_scan(&self, pose: &WheelPose, s0: f64, mut a: f64, mut b: f64) -> [f64; 4] {
+    fn refine_scan(&self, pose: &WheelPose, s0: f64, frame: &RailFrameDerivs, mut a: f64, mut b: f64) -> [f64; 4] {
         let gr = 0.5 * (5f64.sqrt() - 1.0);
-        let frame = self.rail.frame_derivs(s0);
-        let f = |u: f64| self.scan_gap(pose, s0, &frame, u).0;
+        let f = |u: f64| self.scan_gap(pose, s0, frame, u).0;
         let mut c = b - gr * (b - a);
         let mut d = a + gr * (b - a);
         let (mut fc, mut fd) = (f(c), f(d));
@@ -728,33 +726,33 @@ impl WheelRailContact {
                 fd = f(d);
             }
         }
-        self.scan_gap(pose, s0, &frame, 0.5 * (a + b)).1
+        self.scan_gap(pose, s0, frame, 0.5 * (a + b)).1
     }
 
     /// Whether Newton's solution `q` lies on both profiles and within 0.5 rad of the wheel
-    /// circle's lowest point. The wheel angle `θ = q[3]` is measured in the wheel's body frame,
-    /// which turns with the wheel as it rolls, so the bound applies to θ relative to the lowest
-    /// point's angle at the pose (wrapped to ±π), not to θ itself: a bound on θ itself rejected
-    /// every converged solution of a rolling wheel whose spin angle was beyond ±0.5 rad (about
-    /// three quarters of the evaluations of a running car), and the search then took the
-    /// scan's fall-back point under the wheel centre instead of the contact point.
-    fn in_domain(&self, pose: &WheelPose, q: &[f64; 4]) -> bool {
+    /// circle's lowest point, whose angle is `lowest` ([`Self::lowest_angle`] at the wheel's
+    /// station). The wheel angle `θ = q[3]` is measured in the wheel's body frame, which turns
+    /// with the wheel as it rolls, so the bound applies to θ relative to the lowest point's
+    /// angle (wrapped to ±π), not to θ itself: a bound on θ itself rejected every converged
+    /// solution of a rolling wheel whose spin angle was beyond ±0.5 rad (about three quarters
+    /// of the evaluations of a running car), and the search then took the scan's fall-back
+    /// point under the wheel centre instead of the contact point.
+    fn in_domain(&self, q: &[f64; 4], lowest: f64) -> bool {
         let (rl, rh) = self.rail.profile.y_range();
         let (wl, wh) = self.wheel.profile.y_range();
-        if !(q.iter().all(|x| x.is_finite()) && q[1] >= rl && q[1] <= rh && q[2] >= wl && q[2] <= wh) {
-            return false;
-        }
-        let lowest = Self::lowest_angle(pose, &self.rail.frame_derivs(q[0]));
         let rel = (q[3] - lowest + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
-        rel.abs() < 0.5
+        q.iter().all(|x| x.is_finite()) && q[1] >= rl && q[1] <= rh && q[2] >= wl && q[2] <= wh && rel.abs() < 0.5
     }
 
-    /// The wheel angle θ (body frame) of the lowest point of the wheel's circles in the rail
-    /// frame `fd`.
-    fn lowest_angle(pose: &WheelPose, fd: &RailFrameDerivs) -> f64 {
+    /// The wheel's body x and z axes in the rail frame `fd`.
+    fn wheel_axes(pose: &WheelPose, fd: &RailFrameDerivs) -> (Vector3<f64>, Vector3<f64>) {
         let mt = fd.rot.transpose();
-        let a = mt * pose.rotation.column(0);
-        let b = mt * pose.rotation.column(2);
+        (mt * pose.rotation.column(0), mt * pose.rotation.column(2))
+    }
+
+    /// The wheel angle θ (body frame) of the lowest point of the wheel's circles, from the
+    /// wheel's body x and z axes `a`, `b` in the rail frame ([`Self::wheel_axes`]).
+    fn lowest_angle(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
         (-a.z).atan2(b.z)
     }
 
@@ -776,12 +774,17 @@ impl WheelRailContact {
         }
         let s0 = self.rail.station(&pose.position, self.last_station)?;
         self.last_station = Some(s0);
+        // the rail frame at the wheel's station: the scan's, and where the lowest point of the
+        // wheel (the reference of the wheel angle bound) is
+        let fd0 = self.rail.frame_derivs(s0);
+        let (a0, b0) = Self::wheel_axes(pose, &fd0);
+        let lowest = Self::lowest_angle(&a0, &b0);
         // Warm start only.
         if !self.settings.always_scan && !self.previous.is_empty() {
             let mut ok = true;
             for k in 0..self.previous.len() {
                 match self.newton(pose, self.previous[k]) {
-                    Ok(q) if self.in_domain(pose, &q) => out.push(self.geometry_at(pose, q, ContactMethod::Newton)),
+                    Ok(q) if self.in_domain(&q, lowest) => out.push(self.geometry_at(pose, q, ContactMethod::Newton)),
                     _ => {
                         ok = false;
                         break;
@@ -797,14 +800,14 @@ impl WheelRailContact {
             out.clear();
         }
         let (mut vals, mut seeds) = (std::mem::take(&mut self.scratch.scan), std::mem::take(&mut self.scratch.seeds));
-        self.scan(pose, s0, &mut vals, &mut seeds);
+        self.scan(pose, s0, &fd0, &mut vals, &mut seeds);
         for &(_, seed, ulo, uhi) in &seeds {
             // Prefer a previous solution close to this seed as the starting guess.
             let start = self.previous.iter().find(|p| (p[2] - seed[2]).abs() < 2e-3).copied().unwrap_or(seed);
             // a Newton solution from `from` that stays in the domain near this seed, and its
             // geometry when both relative curvatures are positive
             let converged = |from: [f64; 4]| {
-                self.newton(pose, from).ok().filter(|q| self.in_domain(pose, q) && (q[2] - seed[2]).abs() < 5e-3)
+                self.newton(pose, from).ok().filter(|q| self.in_domain(q, lowest) && (q[2] - seed[2]).abs() < 5e-3)
             };
             let convex = |q: [f64; 4]| {
                 Some(self.geometry_at(pose, q, ContactMethod::Newton))
@@ -814,7 +817,7 @@ impl WheelRailContact {
             let g = match solved.and_then(convex) {
                 Some(g) => g,
                 None => {
-                    let q = self.refine_scan(pose, s0, ulo, uhi);
+                    let q = self.refine_scan(pose, s0, &fd0, ulo, uhi);
                     // Newton once more from the refined scan point: when it converges the
                     // point is exact (and the same whichever start the search had), the scan
                     // point only approximate
