@@ -12,14 +12,12 @@
 //! `((D_SEP − dist)/(D_SEP − D_COMB))^0.8`. The Manchester benchmark's values: A_SEP = 90°,
 //! D_SEP = 8 mm, D_COMB = 4 mm.
 use nalgebra::Vector3;
-use rail_mbs::profile::{s1002_wheel, uic60_rail};
 use rail_mbs::track::Side;
 use rail_mbs::wheel_rail::manchester::{
     MANCHESTER_DIR, MANCHESTER_FILES, find_dataset, manchester_contact_pair, parse_manchester_reference,
 };
 use rail_mbs::wheel_rail::{
-    ContactError, ContactPoint, CreepModel, RailGeometry, RailPath, VerticalTarget, WheelGeometry, WheelPose,
-    WheelRailContact, WheelState, solve_vertical,
+    ContactError, ContactPoint, CreepModel, VerticalTarget, WheelPose, WheelRailContact, WheelState, solve_vertical,
 };
 
 const A_SEP: f64 = std::f64::consts::FRAC_PI_2;
@@ -104,23 +102,7 @@ fn main() {
         Err(e) => println!("Manchester case skipped: {e}"),
     }
     // The analytic S1002/UIC 60 pair at 1:40, 60 kN, shifts 0-10 mm towards the left flange.
-    let rail = uic60_rail(2e-4).expect("UIC 60");
-    let offset = RailGeometry::offset_for_gauge(&rail, 1.435, 0.014).expect("gauge point");
-    let mut c = WheelRailContact::new(
-        WheelGeometry {
-            profile: s1002_wheel(2e-4).expect("S1002"),
-            nominal_radius: 0.46,
-            profile_offset: 0.75,
-            side: Side::Left,
-        },
-        RailGeometry {
-            profile: rail,
-            side: Side::Left,
-            profile_offset: offset,
-            vertical_offset: 0.0,
-            path: RailPath::Straight { inward_cant: 1.0 / 40.0 },
-        },
-    );
+    let mut c = railslosh_cases::contact::s1002_on_uic60(Side::Left).expect("S1002 on UIC 60");
     println!("S1002 on UIC 60 1:40 (analytic), left wheel, 60 kN, 20 m/s (shifts where we find two points):");
     for k in 0..=100 {
         let y = 1e-4 * k as f64;

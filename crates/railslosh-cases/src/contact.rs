@@ -45,6 +45,7 @@ use rail_mbs::wheel_rail::{
 use crate::Record;
 
 mod across_profile;
+pub use across_profile::s1002_on_uic60;
 
 /// Names of the contact cases.
 pub const CASES: [&str; 6] = [

@@ -22,8 +22,9 @@ use crate::Record;
 
 const R0: f64 = 0.46;
 
-/// One wheel of the S1002/UIC 60 pair (module docs) on `side`.
-fn s1002_on_uic60(side: Side) -> Result<WheelRailContact, ValidationError> {
+/// One wheel of the S1002/UIC 60 pair (module docs) on `side`: S1002 wheel (r0 = 0.46 m) on
+/// the analytic UIC 60 rail canted 1:40, gauge 1435 mm at 14 mm.
+pub fn s1002_on_uic60(side: Side) -> Result<WheelRailContact, ValidationError> {
     let rail = uic60_rail(2e-4)?;
     let offset = RailGeometry::offset_for_gauge(&rail, 1.435, 0.014).ok_or_else(|| {
         ValidationError::from(DataError::BadData { file: "UIC60 (analytic)".into(), message: "no gauge point".into() })
