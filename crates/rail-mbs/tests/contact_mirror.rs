@@ -70,7 +70,7 @@ fn the_right_wheel_is_the_mirror_image_of_the_left_wheel_over_a_sweep_of_shifts(
             let mp = pose.mirrored();
             let (fr, mr, nr) = resultant(&mut right, &mp);
             *counts.entry(nl.len()).or_insert(0) += 1;
-            assert!(!nl.is_empty(), "the wheel touches the rail");
+            assert!(!nl.is_empty(), "the wheel touches the rail at y = {y}, yaw {yaw}, roll {roll}");
             assert_eq!(nl.len(), nr.len(), "contact-point count at y = {y}, yaw {yaw}, roll {roll}");
             let scale = fl.norm().max(1.0);
             let ef = (fr - mirror_vector(&fl)).norm() / scale;
@@ -158,7 +158,13 @@ fn the_contact_does_not_depend_on_where_the_track_lies() {
         )
     };
     let (mut here, mut there) = (make(Vector3::zeros()), make(shift));
-    let mut worst: f64 = 0.0;
+    // Newton points agree to round-off (1e-9). A scan fall-back point is the minimum of a
+    // gap that Newton could not solve: at 60 kN that happens only at 7.1 mm, in the conformal
+    // stretch of the flange root (relative lateral curvature B ~ 0, docs/validation.md "The
+    // scan's gap at the flange root"), where the gap is flat and its minimum is located only
+    // to about sqrt(round-off of the coordinates / B) ~ sqrt(3e-14 m / 0.06 m^-1) ~ 1 um: those
+    // points are checked to 2 um in position and 1e-6 in force, and there is at most one.
+    let (mut worst, mut worst_flat, mut flat): (f64, f64, usize) = (0.0, 0.0, 0);
     for k in 0..=40 {
         let y = -0.004 + 3e-4 * k as f64;
         let mut pose = WheelPose {
@@ -172,10 +178,26 @@ fn the_contact_does_not_depend_on_where_the_track_lies() {
         let (fa, _, na) = resultant(&mut here, &pose);
         let (fb, _, nb) = resultant(&mut there, &moved);
         assert_eq!(na.len(), nb.len(), "y = {y}");
-        worst = worst.max((fa - fb).norm() / fa.norm());
+        let rel = (fa - fb).norm() / fa.norm();
+        here.reset();
+        there.reset();
+        let (pa, pb) = (here.evaluate(&pose).unwrap(), there.evaluate(&moved).unwrap());
+        if pa.iter().chain(&pb).all(|p| p.geometry.method == rail_mbs::wheel_rail::ContactMethod::Newton) {
+            worst = worst.max(rel);
+        } else {
+            flat += 1;
+            worst_flat = worst_flat.max(rel);
+            for (a, b) in pa.iter().zip(&pb) {
+                assert!((a.point() + shift - b.point()).norm() < 2e-6, "y = {y}: fall-back point moved");
+            }
+        }
     }
-    println!("track moved by {shift:?}: worst relative force difference {worst:.2e}");
+    println!(
+        "track moved by {shift:?}: worst relative force difference {worst:.2e} (Newton points); {flat} poses with \
+         fall-back points, worst {worst_flat:.2e}"
+    );
     assert!(worst < 1e-9, "{worst}");
+    assert!(flat <= 1 && worst_flat < 1e-6, "{flat} poses with fall-back points, worst {worst_flat}");
 }
 
 /// Largest distance (m) between the warm-started and the fresh contact points at the target

@@ -11,7 +11,8 @@
 //! with `t` the surface tangents and `n_r = t1r × t2r` the rail normal. `C = 0` is solved
 //! by Newton–Raphson with the analytic Jacobian ([`WheelRailContact::constraint_jacobian`]).
 //! Each solve is seeded from a 1-D scan over the wheel's lateral profile coordinate
-//! (vertical gap between each wheel circle's lowest point and the rail profile), whose
+//! (the signed distance from each wheel circle's lowest point to the rail profile, along the
+//! rail normal at the foot of the perpendicular), whose
 //! local minima give one seed per potential contact (tread and flange can touch at the
 //! same time), and warm-started from the previous solution when one is near. The
 //! penetration is `δ = −r_wr·n̂_r` (positive when the bodies overlap); a negative `δ`
