@@ -162,8 +162,12 @@ fn the_contact_does_not_depend_on_where_the_track_lies() {
     // gap that Newton could not solve: at 60 kN that happens only at 7.1 mm, in the conformal
     // stretch of the flange root (relative lateral curvature B ~ 0, docs/validation.md "The
     // scan's gap at the flange root"), where the gap is flat and its minimum is located only
-    // to about sqrt(round-off of the coordinates / B) ~ sqrt(3e-14 m / 0.06 m^-1) ~ 1 um: those
-    // points are checked to 2 um in position and 1e-6 in force, and there is at most one.
+    // to about sqrt(round-off of the coordinates / B) ~ sqrt(3e-14 m / 0.06 m^-1) ~ 1 um. Its
+    // force takes Hertz's lateral curvature from the interpenetration region measured along
+    // the normal at that point (`WheelRailContact::lateral_curvature`), and the normal turns
+    // with the point's position by the rail's curvature (77 1/m x 1 um ~ 8e-5 rad): those
+    // points are checked to 2 um in position and 1e-5 in force (measured 8.3e-8 with the local
+    // curvature, 2.8e-6 with the region's), and there is at most one.
     let (mut worst, mut worst_flat, mut flat): (f64, f64, usize) = (0.0, 0.0, 0);
     for k in 0..=40 {
         let y = -0.004 + 3e-4 * k as f64;
@@ -197,7 +201,7 @@ fn the_contact_does_not_depend_on_where_the_track_lies() {
          fall-back points, worst {worst_flat:.2e}"
     );
     assert!(worst < 1e-9, "{worst}");
-    assert!(flat <= 1 && worst_flat < 1e-6, "{flat} poses with fall-back points, worst {worst_flat}");
+    assert!(flat <= 1 && worst_flat < 1e-5, "{flat} poses with fall-back points, worst {worst_flat}");
 }
 
 /// Largest distance (m) between the warm-started and the fresh contact points at the target

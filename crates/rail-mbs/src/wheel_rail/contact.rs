@@ -729,6 +729,57 @@ impl WheelRailContact {
         )
     }
 
+    /// The relative lateral curvature `B` of Hertz's ellipse at contact `g`: the local one,
+    /// except in conformal contact, where it is a small difference of two large curvatures
+    /// (below [`CONFORMAL_CURVATURE_RATIO`] times the rail's curvature there). There it is
+    /// not less than [`CONFORMAL_REGION_FACTOR`] times the curvature `δ/w²` of the parabola
+    /// with the width `2w` of the rigid interpenetration region ([`Self::region_curvature`]).
+    ///
+    /// At the S1002 flange root on UIC 60 the profiles conform over a few millimetres: the
+    /// local `B` jumps between −0.4 and 1.2 1/m from one 3 µm shift to the next, and with it
+    /// Hertz's force at a given penetration (∝ B^−1/4 as B → 0), by up to a factor 2; the
+    /// region's curvature changes smoothly (1.4 → 2.7 1/m), and with half of it the normal
+    /// force lies 8–18 % below a Kik–Piotrowski patch's over that stretch, where the local
+    /// `B` gave −12 % to +75 % (docs/validation.md, "The conformal stretch of the flange
+    /// root"). Elsewhere the local curvature is the larger and is kept, and the rule is
+    /// continuous where it starts to apply (the larger of two continuous curvatures).
+    fn lateral_curvature(&self, pose: &WheelPose, g: &ContactGeometry) -> f64 {
+        let b = g.curvature_y;
+        if b >= CONFORMAL_CURVATURE_RATIO * self.rail.profile.curvature(g.params[1]).abs() || g.penetration <= 0.0 {
+            return b;
+        }
+        self.region_curvature(pose, g).map_or(b, |br| b.max(CONFORMAL_REGION_FACTOR * br))
+    }
+
+    /// The curvature `δ/w²` of the parabola whose rigid interpenetration region `h(y) < δ`
+    /// has the width `2w` of contact `g`'s, with `h` the undeformed separation across the
+    /// contact ([`Self::separation`], sampled every 0.25 mm over ±12 mm, the ends of the
+    /// region interpolated linearly, an end beyond 12 mm taken at 12 mm).
+    pub fn region_curvature(&self, pose: &WheelPose, g: &ContactGeometry) -> Option<f64> {
+        let (half, spacing) = (0.012, 2.5e-4);
+        let s = self.separation(pose, g, half, spacing).ok()?;
+        let d = g.penetration;
+        let i0 = s.y.iter().position(|&y| y == 0.0)?;
+        // the crossing h = δ from sample i0 outward in direction `step` (±1), or the last sample
+        let end = |step: isize| {
+            let mut i = i0 as isize;
+            loop {
+                let j = i + step;
+                if j < 0 || j as usize >= s.y.len() {
+                    return s.y[i as usize];
+                }
+                let (hi_, hj) = (s.h[i as usize], s.h[j as usize]);
+                if hj >= d {
+                    let t = (d - hi_) / (hj - hi_);
+                    return s.y[i as usize] + t * (s.y[j as usize] - s.y[i as usize]);
+                }
+                i = j;
+            }
+        };
+        let w = 0.5 * (end(1) - end(-1));
+        (w > 0.0).then(|| d / (w * w))
+    }
+
     /// A scan minimum farther from the rail than this (a tenth of the seeds' gap limit) is
     /// separated: it carries no force and cannot touch within a step (its seed gets a short
     /// Newton search and no fall-back point).
@@ -1009,7 +1060,8 @@ impl WheelRailContact {
         let nu = 0.5 * (self.wheel_material.poisson + self.rail_material.poisson);
         for &g in geoms.iter().filter(|g| g.penetration > 0.0) {
             let kmin = self.settings.min_relative_curvature;
-            let hertz = HertzConstants::new(g.curvature_x.max(kmin), g.curvature_y.max(kmin), e_star)?;
+            let hertz =
+                HertzConstants::new(g.curvature_x.max(kmin), self.lateral_curvature(pose, &g).max(kmin), e_star)?;
             let p = 0.5 * (g.point_rail + g.point_wheel);
             let r = p - pose.position;
             let v = pose.velocity + pose.angular_velocity.cross(&r);
@@ -1102,6 +1154,14 @@ impl WheelRailContact {
         Ok(())
     }
 }
+
+/// A contact is conformal where its relative lateral curvature is below this fraction of the
+/// rail profile's curvature at the point ([`WheelRailContact::lateral_curvature`]).
+pub const CONFORMAL_CURVATURE_RATIO: f64 = 0.1;
+/// In conformal contact Hertz's lateral curvature is at least this fraction of the curvature of
+/// the parabola with the rigid interpenetration region's width
+/// ([`WheelRailContact::lateral_curvature`]).
+pub const CONFORMAL_REGION_FACTOR: f64 = 0.5;
 
 /// Half-width of the separation sampled for a Kik–Piotrowski patch, m.
 pub const KP_SEPARATION_HALF_WIDTH: f64 = 0.025;
