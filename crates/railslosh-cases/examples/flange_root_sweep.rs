@@ -2,35 +2,17 @@
 //! swept toward the flange, each contact point printed with its lateral place on the wheel
 //! (from the wheelset centre), penetration, relative curvatures (the local `B` at the point,
 //! and `B_region = δ/w²` of the rigid interpenetration region `h(y) < δ` of half-width `w`,
-//! with that region's extent), normal force and how it was found (docs/validation.md, "The
-//! scan's gap at the flange root").
+//! `WheelRailContact::region_curvature`, with that `w`), normal force and how it was found
+//! (docs/validation.md, "The scan's gap at the flange root" and "The conformal stretch of the
+//! flange root").
 //!
 //! `cargo run --release -p railslosh-cases --example flange_root_sweep -- MODE LOAD Y0 SPAN N [Y_REF]`
 //! - `MODE` `load`: at each shift the wheel height that carries `LOAD` (N); `fixed`: the height
 //!   that carries `LOAD` at shift `Y_REF` (m), kept;
 //! - the shifts `Y0 + SPAN k/N` (m), k = 0..N; the wheel rolls at 8.33 m/s, no yaw.
 use rail_mbs::track::Side;
-use rail_mbs::wheel_rail::{
-    ContactError, ContactGeometry, VerticalTarget, WheelPose, WheelRailContact, WheelState, solve_vertical,
-};
+use rail_mbs::wheel_rail::{VerticalTarget, WheelState, solve_vertical};
 use railslosh_cases::contact::s1002_on_uic60;
-
-/// `(B_region, lower end, upper end)` of the rigid interpenetration region around `g`
-/// (separation sampled over ±12 mm every 0.05 mm; an end at the sampled edge is open).
-fn region(c: &WheelRailContact, pose: &WheelPose, g: &ContactGeometry) -> Result<(f64, f64, f64), ContactError> {
-    let s = c.separation(pose, g, 0.012, 5e-5)?;
-    let d = g.penetration;
-    let i0 = s.y.iter().position(|&y| y == 0.0).unwrap_or(0);
-    let (mut lo, mut hi) = (i0, i0);
-    while hi + 1 < s.y.len() && s.h[hi + 1] < d {
-        hi += 1;
-    }
-    while lo > 0 && s.h[lo - 1] < d {
-        lo -= 1;
-    }
-    let w = 0.5 * (s.y[hi] - s.y[lo]);
-    Ok((d / (w * w), s.y[lo], s.y[hi]))
-}
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let a: Vec<String> = std::env::args().skip(1).collect();
@@ -63,15 +45,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let f: nalgebra::Vector3<f64> = pts.iter().map(|p| p.force_on_wheel()).sum();
         let mut line = format!("y {:7.3} mm  Fy {:9.0} N  Fz {:9.0} N |", y * 1e3, f.y, f.z);
         for p in &pts {
-            let (b_region, lo, hi) = region(&c, &pose, &p.geometry)?;
+            let b_region = c.region_curvature(&pose, &p.geometry).unwrap_or(f64::NAN);
             line += &format!(
-                " [at {:7.2} mm  δ {:6.1} µm  B {:6.2}  B_region {:6.2} ({:+6.2}..{:+6.2} mm)  A {:5.2}  N {:7.0}  {:?}]",
+                " [at {:7.2} mm  δ {:6.1} µm  B {:6.2}  B_region {:6.2} (region ±{:5.2} mm)  A {:5.2}  N {:7.0}  {:?}]",
                 (p.point().y - y) * 1e3,
                 p.geometry.penetration * 1e6,
                 p.geometry.curvature_y,
                 b_region,
-                lo * 1e3,
-                hi * 1e3,
+                (p.geometry.penetration / b_region).sqrt() * 1e3,
                 p.geometry.curvature_x,
                 p.normal_force,
                 p.geometry.method

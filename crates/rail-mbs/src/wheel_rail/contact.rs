@@ -739,7 +739,7 @@ impl WheelRailContact {
     /// local `B` jumps between −0.4 and 1.2 1/m from one 3 µm shift to the next, and with it
     /// Hertz's force at a given penetration (∝ B^−1/4 as B → 0), by up to a factor 2; the
     /// region's curvature changes smoothly (1.4 → 2.7 1/m), and with half of it the normal
-    /// force lies 8–18 % below a Kik–Piotrowski patch's over that stretch, where the local
+    /// force lies 8–19 % below a Kik–Piotrowski patch's over that stretch, where the local
     /// `B` gave −12 % to +75 % (docs/validation.md, "The conformal stretch of the flange
     /// root"). Elsewhere the local curvature is the larger and is kept, and the rule is
     /// continuous where it starts to apply (the larger of two continuous curvatures).
