@@ -326,9 +326,9 @@ fn conformal_contact_at_the_flange_root_has_a_continuous_force_close_to_kik_piot
     // millimetres: the local relative curvature B is a small difference of two curvatures of
     // about 77 1/m and jumps between -0.4 and 1.2 1/m from one micrometre of shift to the next,
     // and Hertz's force at a given penetration with it (by up to a factor 2 against a
-    // Kik-Piotrowski patch). In conformal contact B is at least half the curvature of the parabola as wide as
-    // the rigid interpenetration region (`WheelRailContact::lateral_curvature`), which changes
-    // smoothly. Left wheel, 7.060-7.130 mm toward the flange in 1 um steps, the height fixed
+    // Kik-Piotrowski patch). In conformal contact B is at least half the curvature of the
+    // parabola as wide as the rigid interpenetration region
+    // (`WheelRailContact::lateral_curvature`), which changes smoothly. Left wheel, 7.060-7.130 mm toward the flange in 1 um steps, the height fixed
     // where 95 kN are carried at 7.1 mm, fresh searches: the normal force changes by less than
     // 3 % per micrometre (measured at most 1.9 %; with the local B: 3.1 % at 7.088 mm) and,
     // where the contact is conformal, lies within 20 % of a Kik-Piotrowski patch's at the same
