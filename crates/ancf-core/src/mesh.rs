@@ -8,11 +8,19 @@
 //!
 //! Node gradients are central differences of the map with a small step. Where the map
 //! is not differentiable (the tangency of an ellipsoidal head with the cylindrical shell,
-//! where ∂x/∂ρ is infinite) the small-step gradient blows up; there the gradient is the
-//! secant slope over half an element instead (detected when the small-step gradient is
-//! more than twice the secant one). The mesh's own volume therefore differs slightly from
-//! the exact volume of the region; [`FluidMesh::exact_volume`] keeps the latter so tests
-//! can measure the difference.
+//! where ∂x/∂ρ is infinite) the small-step gradient blows up (detected when it is more
+//! than twice the secant slope over half an element). Such a node lies on the edge of the
+//! map (the head rim, where the wall meets the shell), and there its gradient is the slope
+//! that makes the element edge, a cubic Hermite curve between the node and its neighbour,
+//! the least-squares fit of the map along that edge (the neighbour's slope given); an
+//! interior singular node keeps the secant slope. (Along an edge the brick interpolates
+//! exactly this cubic: its nodal positions and the two slopes along the edge.) The
+//! least-squares edge leaves the tank car's meshes an eighth to a tenth of the volume error
+//! of the secant slope (2×2×2: −0.17 % against −1.3 %; 6×4×2: −0.056 % against −0.58 %), and
+//! the liquid at rest no longer creeps into a gap at the rim (docs/validation.md, "A stable
+//! rest state"). The
+//! mesh's own volume therefore differs slightly from the exact volume of the region;
+//! [`FluidMesh::exact_volume`] keeps the latter so tests can measure the difference.
 //!
 //! All shapes are given in the **tank frame**: x along the tank axis (forward), y to the
 //! left, z up, origin at the tank centre (see `docs/frames.md`).
@@ -207,8 +215,24 @@ fn node_gradient<M: Fn([f64; 3]) -> [f64; 3]>(map: &M, p: [f64; 3], d: usize, ax
     } else {
         (axis[idx + 1] - axis[idx]).min(axis[idx] - axis[idx - 1])
     };
-    // Fourth-order central differences. The maps are analytic beyond the parametric box
-    // as well, so the stencil may leave the domain.
+    let (g, singular) = smooth_gradient(map, p, d, h_el);
+    if !singular || (idx != 0 && idx != n) {
+        return g;
+    }
+    // the edge of the map: fit the element edge toward the neighbour
+    let (dir, nb) = if idx == 0 { (1.0, 1) } else { (-1.0, n - 1) };
+    let mut pn = p;
+    pn[d] = axis[nb];
+    let (m1, _) = smooth_gradient(map, pn, d, h_el);
+    edge_fit(map, p, d, dir * h_el, m1.map(|c| dir * c)).map(|c| dir * c)
+}
+
+/// The gradient of `map` along parametric direction `d` at `p` by fourth-order central
+/// differences with a small step, and whether it is singular there: then (small-step
+/// gradient more than twice the secant one) the secant slope over ±¼ and ±½ of `h_el`
+/// instead. The maps are analytic beyond the parametric box as well, so the stencil may
+/// leave the domain.
+fn smooth_gradient<M: Fn([f64; 3]) -> [f64; 3]>(map: &M, p: [f64; 3], d: usize, h_el: f64) -> ([f64; 3], bool) {
     let diff = |h: f64| -> [f64; 3] {
         let at = |t: f64| {
             let mut q = p;
@@ -222,7 +246,35 @@ fn node_gradient<M: Fn([f64; 3]) -> [f64; 3]>(map: &M, p: [f64; 3], d: usize, ax
     let fine = diff(1e-3 * h_el);
     let secant = diff(0.25 * h_el);
     let norm = |g: &[f64; 3]| (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
-    if norm(&fine) > 2.0 * norm(&secant) { secant } else { fine }
+    if norm(&fine) > 2.0 * norm(&secant) { (secant, true) } else { (fine, false) }
+}
+
+/// The start slope m₀ of the cubic Hermite edge from `p` to `p + h e_d` (signed
+/// parametric length `h`) whose end slope is `m1` (both along the edge's direction) that
+/// fits `map` along the edge best in least squares, component by component:
+/// x(t) = H₀₀x₀ + H₁₀|h|m₀ + H₀₁x₁ + H₁₁|h|m₁, t ∈ [0, 1]; m₀ = ∫H₁₀(x − rest)/(|h|∫H₁₀²),
+/// by the midpoint rule on 400 points (the map's √ singularity at t = 0 is integrable).
+fn edge_fit<M: Fn([f64; 3]) -> [f64; 3]>(map: &M, p: [f64; 3], d: usize, h: f64, m1: [f64; 3]) -> [f64; 3] {
+    const SAMPLES: usize = 400;
+    let at = |t: f64| {
+        let mut q = p;
+        q[d] += t * h;
+        map(q)
+    };
+    let len = h.abs();
+    let (x0, x1) = (at(0.0), at(1.0));
+    let (mut num, mut den) = ([0.0; 3], 0.0);
+    for k in 0..SAMPLES {
+        let t = (k as f64 + 0.5) / SAMPLES as f64;
+        let (t2, t3) = (t * t, t * t * t);
+        let (h00, h10, h01, h11) = (2.0 * t3 - 3.0 * t2 + 1.0, t3 - 2.0 * t2 + t, 3.0 * t2 - 2.0 * t3, t3 - t2);
+        let x = at(t);
+        for c in 0..3 {
+            num[c] += h10 * (x[c] - h00 * x0[c] - h01 * x1[c] - h11 * len * m1[c]);
+        }
+        den += h10 * h10;
+    }
+    num.map(|v| v / (len * den))
 }
 
 /// A rectangular box of fluid `[x0, x0 + size_x] × …` with `counts` elements.
