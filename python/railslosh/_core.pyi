@@ -388,6 +388,7 @@ def run_fluid_train(
     wall_damping_ratio: float = ...,
     wall_adhesion: float = 0.0,
     friction_map: dict[str, Any] | None = None,
+    shear_stabilization: bool = False,
 ) -> dict[str, Any]: ...
 def run_equivalent_train(
     track: list[list[float]],

@@ -261,6 +261,8 @@ def _solver(ds: Any) -> list[tuple[str, str]]:
         rows.append(("wall damping ratio", num(a["wall_damping_ratio"], 3, strip=True)))
     if "wall_adhesion" in a:
         rows.append(("wall adhesion (× ρ g H)", num(a["wall_adhesion"], 3, strip=True)))
+    if "shear_stabilization" in a:
+        rows.append(("shear stabilization", "on" if int(a["shear_stabilization"]) else "off"))
     for k, why, text in (
         ("fluid_model", "fluid_model_reason", "liquid model"),
         ("stepper", "stepper_reason", "stepper"),

@@ -121,6 +121,7 @@ VARIABLES: dict[str, tuple[tuple[str, ...], str, str, str, dict[str, str]]] = {
 }
 
 _SCALARS = ("static_wheel_load", "dof", "fluid_mass", "elements", "wall_damping_ratio", "wall_adhesion")
+_FLAGS = ("shear_stabilization",)
 _CHOICE = ("fluid_model", "fluid_model_reason", "load_filter", "stepper", "stepper_reason")
 """The fluid model of a vehicle scene and why (:mod:`railslosh.fluid_model`), and how its loads were
 recorded (``load_filter``), and the stepper of a slosh run and why (``stepper``, ``stepper_reason``),
@@ -271,6 +272,9 @@ def to_dataset(res: Mapping[str, Any], scene: Any = None) -> Any:
     for k in _SCALARS:
         if k in res and res[k] is not None:
             attrs[k] = res[k]
+    for k in _FLAGS:  # netCDF has no boolean attribute
+        if k in res:
+            attrs[k] = int(bool(res[k]))
     for k in _CHOICE:
         if res.get(k):
             attrs[k] = str(res[k])

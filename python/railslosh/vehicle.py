@@ -256,6 +256,7 @@ def run_fluid(
     friction_map: Mapping[str, Any] | None = None,
     wall_damping_ratio: float = WALL_DAMPING_RATIO,
     wall_adhesion: float = 0.0,
+    shear_stabilization: bool = False,
 ) -> dict[str, Any]:
     """Run tank cars whose tanks carry an ANCF fluid, solved monolithically with the cars.
 
@@ -273,8 +274,10 @@ def run_fluid(
     hits a head, at about 1.35x the run time (docs/validation.md, "Wall damping"). ``wall_adhesion``
     (0 to 50, default 0: a unilateral wall) is the suction the tank wall holds on the wetted liquid,
     in units of the hydrostatic pressure at the bottom ρ g H (docs/validation.md, "Wall peeling";
-    :func:`railslosh.slosh.run`). ``fill`` is the
-    liquid volume fraction, :data:`railslosh.limits.FILL` (0.03 to 0.97, as in scenes).
+    :func:`railslosh.slosh.run`). ``shear_stabilization`` gives a fluid without its own the recommended
+    zero-energy-mode control (:func:`railslosh.fluids.default_shear_stabilization` for the element
+    height), which makes the liquid's rest state stable (docs/validation.md, "A stable rest state").
+    ``fill`` is the liquid volume fraction, :data:`railslosh.limits.FILL` (0.03 to 0.97, as in scenes).
     """
     fill = limits.check("fill", fill)
     wall_damping_ratio = limits.check("wall_damping_ratio", wall_damping_ratio)
@@ -311,11 +314,13 @@ def run_fluid(
                 friction_map=None if friction_map is None else dict(friction_map),
                 wall_damping_ratio=wall_damping_ratio,
                 wall_adhesion=wall_adhesion,
+                shear_stabilization=bool(shear_stabilization),
             )
         )
     res["load_filter"] = load_filter
     res["wall_damping_ratio"] = wall_damping_ratio
     res["wall_adhesion"] = wall_adhesion
+    res["shear_stabilization"] = bool(shear_stabilization)
     if irr is not None:
         res["irregularity"] = irr
     return _raise_on_error(res, "fluid vehicle run")

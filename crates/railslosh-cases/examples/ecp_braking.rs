@@ -1,5 +1,5 @@
 //! One braking run of the crude-oil studies with its wall time and Newton statistics:
-//! `cargo run --release -p railslosh-cases --example ecp_braking -- [light|medium|heavy|water] [nx ny nz] [t_end] [ecp|conventional] [bulkheads|-] [wall_damping_ratio] [condensed|direct] [wall_adhesion]`
+//! `cargo run --release -p railslosh-cases --example ecp_braking -- [light|medium|heavy|water] [nx ny nz] [t_end] [ecp|conventional] [bulkheads|-] [wall_damping_ratio] [condensed|direct] [wall_adhesion] [stab|-]`
 use rail_mbs::defaults::{Oil, SETTLE};
 use rail_mbs::vehicle::BrakeScope;
 use railslosh_cases::vehicle::studies::{BrakingCase, run_braking};
@@ -30,6 +30,7 @@ fn main() {
         wall_damping_ratio,
         wall_adhesion: a.get(9).map_or(0.0, |s| s.parse().unwrap()),
         linear_solver,
+        shear_stabilization: a.get(10).map(|s| s.as_str()) == Some("stab"),
     };
     let r = run_braking(&case).expect("run");
     let s = &r.train;

@@ -289,6 +289,7 @@ fn ecp_braking(
             wall_damping_ratio: ancf_core::contact::WALL_DAMPING_RATIO,
             wall_adhesion: 0.0,
             linear_solver: rail_mbs::integrator::LinearSolverKind::Condensed,
+            shear_stabilization: false,
         };
         let tic = Instant::now();
         let out = run_braking_with(&case, s.step, s.rel_tol);

@@ -428,14 +428,15 @@ pub fn design_brake_torque(mass: f64, v0: f64, v1: f64, duration: f64) -> PyResu
 /// the fluid load on each tank, volume errors and mesh snapshots. `wall_damping_ratio`: the
 /// damping ratio of the liquid column on the penalty wall (`WallContactLaw::with_damping_ratio`);
 /// `wall_adhesion`: the suction an adhesive wall holds on the wetted liquid, in units of ρ g H
-/// (`WallContactLaw::with_adhesion`).
+/// (`WallContactLaw::with_adhesion`); `shear_stabilization`: give a fluid without its own the
+/// recommended shear stabilization (`FluidCargo::shear_stabilization`).
 #[pyfunction]
 #[pyo3(signature = (
     track, *, irregularity=None, cars=1, station=300.0, speed=0.0, t_end=1.0, step=4e-3, record_every=0.02, load_filter="hat_mean", snapshot_every=0.0,
     drive_speed=None, brake_times=None, brake_torques=None, brake_scope="all", brake_factors=None,
     oil="light", fluid=None, counts=(6, 4, 2), fill=0.5, bulkheads=None, wheel_profile="s1002", car=None,
     progress=None, stream=None, wall_damping_ratio=ancf_core::contact::WALL_DAMPING_RATIO, wall_adhesion=0.0,
-    friction_map=None
+    friction_map=None, shear_stabilization=false
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn run_fluid_train<'py>(
@@ -467,6 +468,7 @@ pub fn run_fluid_train<'py>(
     wall_damping_ratio: f64,
     wall_adhesion: f64,
     friction_map: Option<&Bound<'py, PyDict>>,
+    shear_stabilization: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let mut params = car_params(car, wheel_profile)?;
     params.contact.friction_map = friction_map_of(friction_map, &params.contact.rail_profile)?;
@@ -482,6 +484,7 @@ pub fn run_fluid_train<'py>(
     let mut cargo = FluidCargo::new(fluid, [counts.0, counts.1, counts.2], fill, bulkheads.unwrap_or_default());
     cargo.wall_damping_ratio = wall_damping_ratio;
     cargo.wall_adhesion = wall_adhesion;
+    cargo.shear_stabilization = shear_stabilization;
     let track = track_of(track, irregularity)?;
     let mut sc = TrainScenario::single(params, track, station, speed, t_end);
     sc.cars = cars;

@@ -35,19 +35,23 @@ class FluidSpec:
     wall_adhesion: float = 0.0
     """``[tank] wall_adhesion``: suction the wall holds on the wetted liquid, in units of ρ g H (0 to 50;
     0 a unilateral wall: :func:`railslosh.slosh.run`)."""
+    shear_stabilization: bool = False
+    """``[mesh] shear_stabilization``: the recommended zero-energy-mode control
+    (:func:`railslosh.fluids.default_shear_stabilization`), which makes the rest state stable
+    (docs/validation.md, "A stable rest state")."""
 
-    def make_fluid(self, depth: float, element_height: float | None = None, shear_stabilization: bool = False) -> Any:
+    def make_fluid(self, depth: float, element_height: float | None = None) -> Any:
         """The :class:`railslosh.Fluid` for a liquid ``depth`` m deep: penalty ``k = 1000 rho g depth``
         and, when ``element_height`` is given, bulk damping ``0.2 sqrt(k rho) element_height`` (the
         defaults of the slosh validation cases) unless the scene sets them; with
-        ``shear_stabilization`` (and ``element_height``) also the recommended shear stabilization
+        :attr:`shear_stabilization` (and ``element_height``) also the recommended shear stabilization
         :func:`railslosh.fluids.default_shear_stabilization`."""
         rho = self.density()
         k = float(self.custom.get("bulk_penalty", fluids.default_bulk_penalty(rho, depth)))
         c = 0.0 if element_height is None else fluids.default_bulk_damping(k, rho, element_height)
         c = float(self.custom.get("bulk_damping", c))
         gs = 0.0
-        if shear_stabilization and element_height is not None:
+        if self.shear_stabilization and element_height is not None:
             gs = fluids.default_shear_stabilization(rho, element_height)
         if self.oil == "custom":
             args = {key: v for key, v in self.custom.items() if key not in ("density", "model")}
@@ -87,6 +91,8 @@ class FluidSpec:
         if self.slosh_model != "auto":
             fl["slosh_model"] = self.slosh_model
         d: dict[str, Any] = {"fluid": fl, "mesh": {"counts": list(self.counts)}}
+        if self.shear_stabilization:
+            d["mesh"]["shear_stabilization"] = True
         if self.bulkheads:
             d["tank"] = {"bulkheads": [list(b) for b in self.bulkheads]}
         if self.wall_damping_ratio != WALL_DAMPING_RATIO:
@@ -134,6 +140,7 @@ def vehicle_fluid(doc: Mapping[str, Any], params: Mapping[str, float]) -> FluidS
         slosh_model=slosh_model,
         wall_damping_ratio=tk.get("wall_damping_ratio"),
         wall_adhesion=tk.get("wall_adhesion"),
+        shear_stabilization=ms.get("shear_stabilization"),
     )
     if oil == "custom":
         spec.make_fluid(2.0 * params["tank_radius"] * fill)  # validates the custom fluid now

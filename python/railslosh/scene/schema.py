@@ -152,6 +152,7 @@ _WALL_ADHESION = Field(
     0.0,
     PARAMETERS["wall_adhesion"],
 )
+_SHEAR_STABILIZATION = _flag(False, "zero-energy-mode control that makes the rest state stable (docs/validation.md)")
 _BULKHEADS = _value(
     "[[x, thickness], ...] (m, tank frame)",
     "full-height plates, inside the shell, not overlapping, each compartment at least one element long",
@@ -357,6 +358,7 @@ SCHEMA: dict[str, dict[str, dict[str, Field]]] = {
             "counts": _value(
                 "[n_length (1-40), n_width (2-20), n_height (1-10)]", "fluid elements per tank", [6, 4, 2]
             ),
+            "shear_stabilization": _SHEAR_STABILIZATION,
         },
         "tank": {"bulkheads": _BULKHEADS, "wall_damping_ratio": _WALL_DAMPING, "wall_adhesion": _WALL_ADHESION},
         "outputs": {
@@ -394,9 +396,7 @@ SCHEMA: dict[str, dict[str, dict[str, Field]]] = {
             "viscous_points": _int(3, 6, 3, "Gauss points per direction of the viscous stress"),
             "penalty_points": _int(2, 6, 3, "Gauss points per direction of the volumetric penalty"),
             "contact_points_per_edge": _int(2, 6, 3, "wall-contact points per boundary-face edge"),
-            "shear_stabilization": _flag(
-                False, "zero-energy-mode control that makes the rest state stable (docs/validation.md)"
-            ),
+            "shear_stabilization": _SHEAR_STABILIZATION,
         },
         "solver": {
             "t_end": _num(0.0, 600.0, "s", "a time", 2.0, "simulated time", lo_open=True),

@@ -83,9 +83,6 @@ class SloshScene:
     """Gauss points per direction of the volumetric penalty (2 to 6)."""
     contact_points_per_edge: int = 3
     """Wall-contact Gauss points per boundary-face edge (2 to 6)."""
-    shear_stabilization: bool = False
-    """``[mesh] shear_stabilization``: the recommended zero-energy-mode control
-    (:func:`railslosh.fluids.default_shear_stabilization`), which makes the rest state stable."""
     stepper: str = "implicit"
     """``"implicit"``, ``"explicit"`` or ``"auto"`` (:func:`railslosh.slosh.run`)."""
     name: str = ""
@@ -133,7 +130,7 @@ class SloshScene:
         if "bulk_penalty" not in spec.custom:
             k = fluids.default_bulk_penalty(spec.density(), depth) * max(1.0, self.peak_load_factor())
             spec = dataclasses.replace(spec, custom={**spec.custom, "bulk_penalty": k})
-        fluid = spec.make_fluid(depth, depth / spec.counts[2], self.shear_stabilization)
+        fluid = spec.make_fluid(depth, depth / spec.counts[2])
         kw: dict[str, Any] = {
             "t_end": self.t_end,
             "h": self.step,
@@ -175,9 +172,7 @@ def slosh_scene_from_dict(data: Mapping[str, Any]) -> SloshScene:
     fill = fl.get("fill")
     ms = Section("slosh", "mesh", data)
     n = counts(ms.values.get("counts", [2, 4, 2]), "mesh.counts", SLOSH_COUNTS)
-    rules = {
-        k: ms.get(k) for k in ("viscous_points", "penalty_points", "contact_points_per_edge", "shear_stabilization")
-    }
+    rules = {k: ms.get(k) for k in ("viscous_points", "penalty_points", "contact_points_per_edge")}
     tk = Section("slosh", "tank", data)
     zeta = tk.get("wall_damping_ratio")
     tank = slosh_tank(tk, n)
@@ -189,6 +184,7 @@ def slosh_scene_from_dict(data: Mapping[str, Any]) -> SloshScene:
         custom=custom,
         wall_damping_ratio=zeta,
         wall_adhesion=tk.get("wall_adhesion"),
+        shear_stabilization=ms.get("shear_stabilization"),
     )
     man = maneuver(data, t_end)
     outputs = slosh_outputs(data, step)

@@ -167,6 +167,7 @@ class Scene:
             "brake_factors": None if self.brake_factors is None else list(self.brake_factors),
             "wall_damping_ratio": f.wall_damping_ratio,
             "wall_adhesion": f.wall_adhesion,
+            "shear_stabilization": f.shear_stabilization,
         }
         return kw
 
@@ -174,7 +175,7 @@ class Scene:
         """Keyword arguments of :func:`railslosh.vehicle.run_equivalent` (after the track): the liquid
         as its equivalent slosh model along ``slosh_axis``."""
         kw = self.fluid_kwargs()
-        for k in ("counts", "snapshot_every", "wall_damping_ratio", "wall_adhesion"):
+        for k in ("counts", "snapshot_every", "wall_damping_ratio", "wall_adhesion", "shear_stabilization"):
             kw.pop(k)
         kw["slosh_axis"] = slosh_axis
         return kw

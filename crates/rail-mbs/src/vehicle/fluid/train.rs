@@ -45,6 +45,11 @@ pub struct FluidCargo {
     /// How the coupled Newton matrix is solved ([`FluidVehicle::linear_solver`]); default
     /// [`LinearSolverKind::Condensed`].
     pub linear_solver: LinearSolverKind,
+    /// Give a fluid without its own shear stabilization the recommended one
+    /// ([`crate::defaults::default_shear_stabilization`] for the element height, liquid depth /
+    /// `counts[2]`): the zero-energy-mode control that makes the rest state stable
+    /// (docs/validation.md, "A stable rest state"). Default false, as in slosh runs.
+    pub shear_stabilization: bool,
 }
 
 impl FluidCargo {
@@ -66,6 +71,7 @@ impl FluidCargo {
             wall_damping_ratio: ancf_core::contact::WALL_DAMPING_RATIO,
             wall_adhesion: 0.0,
             linear_solver: LinearSolverKind::Condensed,
+            shear_stabilization: false,
         }
     }
 }
@@ -191,13 +197,18 @@ pub fn build_fluid_train(
     } else {
         cylinder_tank_compartments(&spec, &cargo.bulkheads)?
     };
-    let body = FluidBody::new(mesh, cargo.fluid, cargo.quadrature)?;
+    let depth = 2.0 * p.tank_radius * cargo.fill;
+    let mut fluid = cargo.fluid;
+    if cargo.shear_stabilization && fluid.shear_stabilization == 0.0 {
+        let element_height = depth / cargo.counts[2].max(1) as f64;
+        fluid.shear_stabilization = crate::defaults::default_shear_stabilization(fluid.density, element_height);
+    }
+    let body = FluidBody::new(mesh, fluid, cargo.quadrature)?;
     let geometry = TankGeometry::new(
         TankShape::Cylinder { length: spec.length, radius: spec.radius, head_depth: head },
         cargo.bulkheads.iter().map(|&(x, thickness)| Bulkhead { x, thickness }).collect(),
     )?;
     let g = crate::track::GRAVITY;
-    let depth = 2.0 * p.tank_radius * cargo.fill;
     let rho = cargo.fluid.density;
     let mut law = WallContactLaw::default_for(rho, g, depth)
         .with_damping_ratio(cargo.wall_damping_ratio, rho, g, depth)?
