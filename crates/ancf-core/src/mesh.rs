@@ -412,6 +412,11 @@ impl CylinderTankSpec {
         check_range("grading", self.grading, 0.05, 20.0)
     }
 
+    /// The walls of this tank: the shell and its heads.
+    pub fn shape(&self) -> crate::tank::TankShape {
+        crate::tank::TankShape::Cylinder { length: self.length, radius: self.radius, head_depth: self.head_depth }
+    }
+
     /// Total tank volume (m³).
     pub fn tank_volume(&self) -> f64 {
         tank_liquid_volume(self.length, self.radius, self.head_depth, 2.0 * self.radius)

@@ -15,7 +15,7 @@ use ancf_core::contact::{WallContact, WallContactLaw};
 use ancf_core::element::QuadratureOptions;
 use ancf_core::mesh::{CylinderTankSpec, cylinder_tank};
 use ancf_core::shape::N_SHAPE;
-use ancf_core::tank::{TankGeometry, TankShape};
+use ancf_core::tank::TankGeometry;
 use rail_mbs::defaults::{Oil, default_shear_stabilization, slosh_params};
 use rail_mbs::slosh::{PrescribedMotion, SloshFrame, SloshRun, SloshSystem};
 use rail_mbs::vehicle::TankCarParams;
@@ -27,19 +27,8 @@ fn main() {
     let (head, t_end) = (a[3], a[4]);
     let stabilized = args.get(5).map(String::as_str) == Some("stab");
     let p = TankCarParams::standard().unwrap();
-    let spec = CylinderTankSpec {
-        length: p.tank_length - 2.0 * head,
-        radius: p.tank_radius,
-        head_depth: head,
-        fill: 0.5,
-        n_length: c[0],
-        n_width: c[1],
-        n_height: c[2],
-        grading: 1.0,
-    };
-    let geo =
-        TankGeometry::new(TankShape::Cylinder { length: spec.length, radius: spec.radius, head_depth: head }, vec![])
-            .unwrap();
+    let spec = CylinderTankSpec { length: p.tank_length - 2.0 * head, head_depth: head, ..p.tank_spec(0.5, c) };
+    let geo = TankGeometry::new(spec.shape(), vec![]).unwrap();
     let depth = spec.radius;
     let mut fluid = Oil::Light.fluid(depth, depth / c[2] as f64).unwrap();
     if std::env::var("WORK").is_err() {

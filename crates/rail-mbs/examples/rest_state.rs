@@ -57,22 +57,9 @@ fn main() {
         _ => {
             let p = TankCarParams::standard().unwrap();
             let head: f64 = std::env::var("HEAD").map(|s| s.parse().unwrap()).unwrap_or(0.5);
-            let spec = CylinderTankSpec {
-                length: p.tank_length - 2.0 * head,
-                radius: p.tank_radius,
-                head_depth: head,
-                fill: 0.5,
-                n_length: c[0],
-                n_width: c[1],
-                n_height: c[2],
-                grading: 1.0,
-            };
+            let spec = CylinderTankSpec { length: p.tank_length - 2.0 * head, head_depth: head, ..p.tank_spec(0.5, c) };
             let mesh = cylinder_tank(&spec).unwrap();
-            let geo = TankGeometry::new(
-                TankShape::Cylinder { length: spec.length, radius: spec.radius, head_depth: head },
-                vec![],
-            )
-            .unwrap();
+            let geo = TankGeometry::new(spec.shape(), vec![]).unwrap();
             let fl = Oil::Light.fluid(p.tank_radius, p.tank_radius / c[2] as f64).unwrap();
             (mesh, geo, p.tank_radius, fl)
         }

@@ -229,18 +229,9 @@ fn rest_lambda_min(mesh_kind: RestMesh, np: usize, ppe: usize, stabilization: Op
             (mesh, TankGeometry::new(shape, vec![]).unwrap(), depth, c[2])
         }
         RestMesh::Car(c) => {
-            use ancf_core::mesh::{CylinderTankSpec, cylinder_tank};
-            let p = rail_mbs::vehicle::TankCarParams::standard().unwrap();
-            let head = 0.5;
-            let spec = CylinderTankSpec {
-                length: p.tank_length - 2.0 * head,
-                n_length: c[0],
-                n_width: c[1],
-                n_height: c[2],
-                ..CylinderTankSpec::tank_car(c)
-            };
-            let shape = TankShape::Cylinder { length: spec.length, radius: spec.radius, head_depth: head };
-            (cylinder_tank(&spec).unwrap(), TankGeometry::new(shape, vec![]).unwrap(), spec.radius, c[2])
+            let spec = rail_mbs::vehicle::TankCarParams::standard().unwrap().tank_spec(0.5, c);
+            let mesh = ancf_core::mesh::cylinder_tank(&spec).unwrap();
+            (mesh, TankGeometry::new(spec.shape(), vec![]).unwrap(), spec.radius, c[2])
         }
     };
     let h_el = depth / layers as f64;

@@ -9,7 +9,7 @@ use std::sync::Arc;
 
 use ancf_core::element::QuadratureOptions;
 use ancf_core::error::AncfError;
-use ancf_core::mesh::{CylinderTankSpec, cylinder_tank, cylinder_tank_compartments};
+use ancf_core::mesh::{cylinder_tank, cylinder_tank_compartments};
 use ancf_core::{Fluid, FluidBody, Rheology};
 use nalgebra::{Matrix3, Vector3};
 use rail_mbs::integrator::{Hht, HhtParams};
@@ -29,16 +29,7 @@ fn model(fill: f64, bulkheads: Vec<(f64, f64)>, axis: SloshAxis) -> EquivalentMo
 
 /// The ANCF liquid of the same tank, fill and bulkheads (as `build_fluid_train`).
 fn ancf_liquid(fill: f64, bulkheads: &[(f64, f64)]) -> (FluidBody, f64) {
-    let spec = CylinderTankSpec {
-        length: 11.0,
-        radius: 1.5,
-        head_depth: 0.5,
-        fill,
-        n_length: 9,
-        n_width: 4,
-        n_height: 3,
-        grading: 1.0,
-    };
+    let spec = TankCarParams::standard().unwrap().tank_spec(fill, [9, 4, 3]);
     let mesh = if bulkheads.is_empty() { cylinder_tank(&spec) } else { cylinder_tank_compartments(&spec, bulkheads) };
     let mesh = mesh.unwrap();
     let exact = mesh.exact_volume;

@@ -162,7 +162,28 @@ fn beam(mass: f64, length: f64) -> BodyMass {
     BodyMass { mass, inertia: [0.01 * i + 1.0, i, i] }
 }
 
+/// Depth of the tank's half-ellipsoidal heads, m: seed 000 gives a cylindrical tank "with
+/// half-ellipsoid ends" but not their depth, so this is our choice (as `python/railslosh/mesh.py`'s
+/// `TANK_CAR_HEAD_DEPTH`); the heads lie within the overall `tank_length`.
+pub const TANK_HEAD_DEPTH: f64 = 0.5;
+
 impl TankCarParams {
+    /// The liquid of this car's tank (shell `tank_length − 2·TANK_HEAD_DEPTH` between
+    /// [`TANK_HEAD_DEPTH`] heads, radius `tank_radius`) filled to the volume fraction `fill`,
+    /// meshed with `counts` elements (length, width, height).
+    pub fn tank_spec(&self, fill: f64, counts: [usize; 3]) -> ancf_core::mesh::CylinderTankSpec {
+        ancf_core::mesh::CylinderTankSpec {
+            length: self.tank_length - 2.0 * TANK_HEAD_DEPTH,
+            radius: self.tank_radius,
+            head_depth: TANK_HEAD_DEPTH,
+            fill,
+            n_length: counts[0],
+            n_width: counts[1],
+            n_height: counts[2],
+            grading: 1.0,
+        }
+    }
+
     /// The defaults listed on each field.
     pub fn standard() -> Result<Self, AncfError> {
         let (m, r, l): (f64, f64, f64) = (15_000.0, 1.5, 12.0);

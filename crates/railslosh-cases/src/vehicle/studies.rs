@@ -118,16 +118,7 @@ pub fn run_braking_with(case: &BrakingCase, step: f64, rel_tol: f64) -> Result<F
     // Torque sized with the fluid mass of the mesh (total mass of one car).
     let fluid_mass = {
         let body = ancf_core::FluidBody::new(
-            ancf_core::mesh::cylinder_tank(&ancf_core::mesh::CylinderTankSpec {
-                length: p.tank_length - 1.0,
-                radius: p.tank_radius,
-                head_depth: 0.5,
-                fill: 0.5,
-                n_length: 2,
-                n_width: 2,
-                n_height: 2,
-                grading: 1.0,
-            })?,
+            ancf_core::mesh::cylinder_tank(&p.tank_spec(0.5, [2, 2, 2]))?,
             cg.fluid,
             QuadratureOptions::default(),
         )?;

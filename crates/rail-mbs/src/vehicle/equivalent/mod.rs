@@ -116,14 +116,14 @@ pub struct EquivalentCargo {
     pub bulkheads: Vec<(f64, f64)>,
     /// The sloshing direction.
     pub axis: SloshAxis,
-    /// Depth of each half-ellipsoidal head, m. Default 0.5 (as the ANCF cargo).
+    /// Depth of each half-ellipsoidal head, m. Default [`crate::vehicle::TANK_HEAD_DEPTH`] (as the ANCF cargo).
     pub head_depth: f64,
 }
 
 impl EquivalentCargo {
     /// Cargo with the heads of the ANCF cargo (0.5 m deep).
     pub fn new(density: f64, viscosity: f64, fill: f64, bulkheads: Vec<(f64, f64)>, axis: SloshAxis) -> Self {
-        Self { density, viscosity, fill, bulkheads, axis, head_depth: 0.5 }
+        Self { density, viscosity, fill, bulkheads, axis, head_depth: crate::vehicle::TANK_HEAD_DEPTH }
     }
 
     /// Cargo of an ANCF fluid's density and (plastic) viscosity (module docs).

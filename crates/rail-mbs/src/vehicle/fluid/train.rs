@@ -6,8 +6,8 @@
 use ancf_core::constitutive::Fluid;
 use ancf_core::contact::WallContactLaw;
 use ancf_core::element::QuadratureOptions;
-use ancf_core::mesh::{CylinderTankSpec, cylinder_tank, cylinder_tank_compartments};
-use ancf_core::tank::{Bulkhead, TankGeometry, TankShape};
+use ancf_core::mesh::{cylinder_tank, cylinder_tank_compartments};
+use ancf_core::tank::{Bulkhead, TankGeometry};
 
 use super::*;
 use crate::integrator::{Hht, IntegratorError};
@@ -181,17 +181,7 @@ pub fn build_fluid_train(
     cargo: &FluidCargo,
 ) -> Result<(FluidVehicle, Vec<CarBodies>, Vec<usize>), AncfError> {
     let p = &sc.car;
-    let head = 0.5;
-    let spec = CylinderTankSpec {
-        length: p.tank_length - 2.0 * head,
-        radius: p.tank_radius,
-        head_depth: head,
-        fill: cargo.fill,
-        n_length: cargo.counts[0],
-        n_width: cargo.counts[1],
-        n_height: cargo.counts[2],
-        grading: 1.0,
-    };
+    let spec = p.tank_spec(cargo.fill, cargo.counts);
     let mesh = if cargo.bulkheads.is_empty() {
         cylinder_tank(&spec)?
     } else {
@@ -205,7 +195,7 @@ pub fn build_fluid_train(
     }
     let body = FluidBody::new(mesh, fluid, cargo.quadrature)?;
     let geometry = TankGeometry::new(
-        TankShape::Cylinder { length: spec.length, radius: spec.radius, head_depth: head },
+        spec.shape(),
         cargo.bulkheads.iter().map(|&(x, thickness)| Bulkhead { x, thickness }).collect(),
     )?;
     let g = crate::track::GRAVITY;
