@@ -15,6 +15,7 @@ _Progress = Callable[[float, float, int, int, int], object]
 WALL_DAMPING_RATIO: float
 LUBRICATED_GAUGE_FACE: dict[str, float]
 GRAVITY: float
+TANK_HEAD_DEPTH: float
 FOOT: float
 INCH: float
 MPH: float

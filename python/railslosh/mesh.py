@@ -16,8 +16,9 @@ from railslosh._core import FluidMesh
 TANK_CAR_LENGTH = 12.0
 TANK_CAR_RADIUS = 1.5
 #: Head depth of the tank car. The paper gives none; 0.5 m is a typical 2:1-type
-#: semi-ellipsoidal head depth for a 3 m diameter DOT-111/117 car (R/3).
-TANK_CAR_HEAD_DEPTH = 0.5
+#: semi-ellipsoidal head depth for a 3 m diameter DOT-111/117 car (R/3). The vehicle runs' value,
+#: ``rail_mbs::vehicle::TANK_HEAD_DEPTH``.
+TANK_CAR_HEAD_DEPTH: float = _core.TANK_HEAD_DEPTH
 
 #: SwRI elliptical tank of seed 003 appendix C: 22.9845 y^2 + 57.2785 z^2 = 1, L = 0.324 m.
 SWRI_SEMI_AXIS_Y = 1.0 / math.sqrt(22.9845)
