@@ -583,32 +583,37 @@ def test_the_wall_damping_ratio_reaches_the_fluid_run_and_its_results():
 
 
 def test_the_shear_stabilization_reaches_the_runs_of_vehicle_and_slosh_scenes():
-    """``[mesh] shear_stabilization`` (default false) is one key for both scene kinds: it goes to
-    run_fluid (and into the results' attributes) and to the slosh scene's fluid, reads back from
-    to_dict, is refused when not a flag, naming the field, and does not go to the equivalent model.
-    Every shipped crude-oil car scene opts in (docs/validation.md, "A stable rest state")."""
+    """``[mesh] shear_stabilization`` (default true: the rest state of the default and shipped meshes
+    is stable only with it) is one key for both scene kinds: it goes to run_fluid (and into the
+    results' attributes) and to the slosh scene's fluid, reads back from to_dict, is refused when not a
+    flag, naming the field, and does not go to the equivalent model. The SwRI bump scenes turn it off
+    (docs/validation.md, "A stable rest state")."""
     base = _set_dotted(FLUID_BASE, "train.t_end", 0.3)
-    assert scene.load_scene(base).fluid_kwargs()["shear_stabilization"] is False
-    sc = scene.load_scene(_set_dotted(base, "mesh.shear_stabilization", True))
+    sc = scene.load_scene(base)
     assert sc.fluid.shear_stabilization and sc.fluid_kwargs()["shear_stabilization"] is True
-    assert "shear_stabilization" not in sc.equivalent_kwargs("longitudinal")
-    assert scene.load_scene(sc.to_dict()).fluid == sc.fluid
+    bare = scene.load_scene(_set_dotted(base, "mesh.shear_stabilization", False))
+    assert not bare.fluid.shear_stabilization and bare.fluid_kwargs()["shear_stabilization"] is False
+    assert "shear_stabilization" not in bare.equivalent_kwargs("longitudinal")
+    assert scene.load_scene(bare.to_dict()).fluid == bare.fluid
+    assert scene.load_scene(bare.fluid.to_sections() | {"track": base["track"]}).fluid == bare.fluid
     with pytest.raises(ValueError, match=r"`mesh.shear_stabilization`"):
         scene.load_scene(_set_dotted(base, "mesh.shear_stabilization", "yes"))
     rows = sc.track_rows
-    plain = railslosh.vehicle.run_fluid(rows, **scene.load_scene(base).fluid_kwargs())
     stabilized = railslosh.vehicle.run_fluid(rows, **sc.fluid_kwargs())
+    plain = railslosh.vehicle.run_fluid(rows, **bare.fluid_kwargs())
     assert stabilized["shear_stabilization"] is True and plain["shear_stabilization"] is False
-    assert results.to_dataset(stabilized).attrs["shear_stabilization"] == 1
+    assert results.to_dataset(plain).attrs["shear_stabilization"] == 0
     # the stabilization stress is zero in the reference state and grows with the liquid's shear:
     # the runs part as the liquid falls onto the walls
     f0, f1 = np.asarray(plain["fluid_force_tank"]), np.asarray(stabilized["fluid_force_tank"])
     assert np.abs(f1 - f0).max() > 0.0
-    sl = scene.load_scene(_set_dotted(SLOSH_BASE, "mesh.shear_stabilization", True))
-    assert sl.fluid.shear_stabilization and sl.run_args()[0][1].shear_stabilization > 0.0
-    assert scene.load_scene(SLOSH_BASE).run_args()[0][1].shear_stabilization == 0.0
-    for path in sorted((ROOT / "examples" / "scenes").glob("crude_*.toml")):
-        assert scene.load_scene(path).fluid.shear_stabilization, path.name
+    assert scene.load_scene(SLOSH_BASE).run_args()[0][1].shear_stabilization > 0.0
+    sl = scene.load_scene(_set_dotted(SLOSH_BASE, "mesh.shear_stabilization", False))
+    assert not sl.fluid.shear_stabilization and sl.run_args()[0][1].shear_stabilization == 0.0
+    for path in sorted((ROOT / "examples" / "scenes").glob("*.toml")):
+        sc = scene.load_scene(path)
+        if sc.fluid is not None:
+            assert sc.fluid.shear_stabilization == (not path.name.startswith("swri_bump")), path.name
 
 
 def test_the_wall_adhesion_reaches_the_runs_of_vehicle_and_slosh_scenes():

@@ -256,7 +256,7 @@ def run_fluid(
     friction_map: Mapping[str, Any] | None = None,
     wall_damping_ratio: float = WALL_DAMPING_RATIO,
     wall_adhesion: float = 0.0,
-    shear_stabilization: bool = False,
+    shear_stabilization: bool = True,
 ) -> dict[str, Any]:
     """Run tank cars whose tanks carry an ANCF fluid, solved monolithically with the cars.
 
@@ -274,9 +274,11 @@ def run_fluid(
     hits a head, at about 1.35x the run time (docs/validation.md, "Wall damping"). ``wall_adhesion``
     (0 to 50, default 0: a unilateral wall) is the suction the tank wall holds on the wetted liquid,
     in units of the hydrostatic pressure at the bottom ρ g H (docs/validation.md, "Wall peeling";
-    :func:`railslosh.slosh.run`). ``shear_stabilization`` gives a fluid without its own the recommended
-    zero-energy-mode control (:func:`railslosh.fluids.default_shear_stabilization` for the element
-    height), which makes the liquid's rest state stable (docs/validation.md, "A stable rest state").
+    :func:`railslosh.slosh.run`). ``shear_stabilization`` (default true, as in scenes) gives a fluid
+    without its own the recommended zero-energy-mode control
+    (:func:`railslosh.fluids.default_shear_stabilization` for the element height), which makes the
+    liquid's rest state stable (docs/validation.md, "A stable rest state"); false runs the bare
+    discretization, whose rest state has growing modes on the car meshes.
     ``fill`` is the liquid volume fraction, :data:`railslosh.limits.FILL` (0.03 to 0.97, as in scenes).
     """
     fill = limits.check("fill", fill)

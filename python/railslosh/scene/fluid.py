@@ -35,10 +35,10 @@ class FluidSpec:
     wall_adhesion: float = 0.0
     """``[tank] wall_adhesion``: suction the wall holds on the wetted liquid, in units of ρ g H (0 to 50;
     0 a unilateral wall: :func:`railslosh.slosh.run`)."""
-    shear_stabilization: bool = False
+    shear_stabilization: bool = True
     """``[mesh] shear_stabilization``: the recommended zero-energy-mode control
     (:func:`railslosh.fluids.default_shear_stabilization`), which makes the rest state stable
-    (docs/validation.md, "A stable rest state")."""
+    (docs/validation.md, "A stable rest state"); on by default in scenes."""
 
     def make_fluid(self, depth: float, element_height: float | None = None) -> Any:
         """The :class:`railslosh.Fluid` for a liquid ``depth`` m deep: penalty ``k = 1000 rho g depth``
@@ -91,8 +91,8 @@ class FluidSpec:
         if self.slosh_model != "auto":
             fl["slosh_model"] = self.slosh_model
         d: dict[str, Any] = {"fluid": fl, "mesh": {"counts": list(self.counts)}}
-        if self.shear_stabilization:
-            d["mesh"]["shear_stabilization"] = True
+        if not self.shear_stabilization:
+            d["mesh"]["shear_stabilization"] = False
         if self.bulkheads:
             d["tank"] = {"bulkheads": [list(b) for b in self.bulkheads]}
         if self.wall_damping_ratio != WALL_DAMPING_RATIO:

@@ -152,7 +152,7 @@ _WALL_ADHESION = Field(
     0.0,
     PARAMETERS["wall_adhesion"],
 )
-_SHEAR_STABILIZATION = _flag(False, "zero-energy-mode control that makes the rest state stable (docs/validation.md)")
+_SHEAR_STABILIZATION = _flag(True, "zero-energy-mode control that makes the rest state stable (docs/validation.md)")
 _BULKHEADS = _value(
     "[[x, thickness], ...] (m, tank frame)",
     "full-height plates, inside the shell, not overlapping, each compartment at least one element long",
