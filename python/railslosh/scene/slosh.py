@@ -4,6 +4,7 @@ the liquid an ANCF fluid mesh, run with :func:`railslosh.slosh.run`."""
 from __future__ import annotations
 
 import dataclasses
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -94,6 +95,17 @@ class SloshScene:
     raw: Mapping[str, Any] = field(default_factory=dict, compare=False, repr=False)
 
     kind = "slosh"
+
+    @property
+    def shear_stabilization(self) -> bool:
+        """Deprecated alias (one release) of ``fluid.shear_stabilization``: the key now lives with the
+        liquid, as in vehicle scenes."""
+        warnings.warn(
+            "SloshScene.shear_stabilization is deprecated: use SloshScene.fluid.shear_stabilization",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return self.fluid.shear_stabilization
 
     def mesh(self) -> Any:
         """The fluid mesh (reference configuration, tank frame)."""
