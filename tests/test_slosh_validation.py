@@ -20,6 +20,7 @@ from railslosh import validate
         "bulkhead-longitudinal",
         "slosh-linear-potential-flow",
         "slosh-load-convergence",
+        "rest-state",
     ],
 )
 def test_quick_slosh_case_passes(case):

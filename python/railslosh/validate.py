@@ -66,6 +66,8 @@ _DESCRIPTIONS = {
     "slosh-load-convergence": "seed 003 rectangular tank, 0.3 g lateral pulse: peak lateral load after the pulse and "
     "f1 from zero crossings of the raw load change <= 5 % between the two finest of three meshes and two step sizes; "
     "raw zero-crossing frequency within 3 % of the spectral peak (no chatter)",
+    "rest-state": "the liquid at rest on the default and shipped meshes (SwRI, rectangular tank, tank car with heads), "
+    "with the recommended shear stabilization: smallest eigenvalue of the linearization about the settled state >= 0",
     "manchester-contact-left": "Manchester contact benchmark A2.2, left wheel (S1002 on UIC60 1:40, 10 kN, shifts "
     "0-10 mm) vs CONTACT: contact position, normal force, creep forces; full form also Polach, FASTSIM and the "
     "Kik-Piotrowski patch (needs shared data)",

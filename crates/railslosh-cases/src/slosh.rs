@@ -10,6 +10,7 @@
 //! | `tank-frame-equivalence` | the same motion given as tank-frame pseudo-forces (seed 003 eq. 7.40) and as prescribed inertial motion gives the same loads |
 //! | `slosh-linear-potential-flow` | seed 003's rectangular tank under a 0.03 g lateral pulse (linear regime): the lateral load history vs the 50-mode linear potential-flow solution ([`rail_mbs::slosh::linear_theory`]), RMS difference over 0.5–4 s ≤ 10 % of its peak; first-mode frequency from zero crossings vs 1.436 Hz |
 //! | `slosh-load-convergence` | the same tank under a 0.3 g lateral pulse (issue 16 §3): the peak lateral load after the pulse and f₁ from the zero crossings of the raw load change by ≤ 5 % between the two finest of three meshes and between two step sizes; on the finest mesh the raw zero-crossing frequency is within 3 % of the spectral peak (no chatter) |
+//! | `rest-state` | issue 16 §6: the liquid at rest on the default and shipped meshes, with the recommended shear stabilization, is a stable equilibrium: the smallest eigenvalue λ = ω²H/g of the linearization about the settled state is ≥ 0 (quick: the SwRI scenes' 1×2×2 and the car scenes' 2×2×2; full: also the rectangular tank's 4×8×3 and 3×6×2, the SwRI 2×4×2 default slosh-scene mesh and 2×4×4, the car's 6×4×2) |
 //!
 //! `quick` selects coarser meshes and shorter runs (as run in CI); the full forms are the
 //! long validation (`railslosh validate`).
@@ -33,7 +34,7 @@ use crate::Record;
 use ancf_core::constants::GRAVITY as G;
 
 /// Names of the slosh cases.
-pub const CASES: [&str; 8] = [
+pub const CASES: [&str; 9] = [
     "hydrostatic-cylinder",
     "slosh-rect-tank",
     "slosh-cylinder-half",
@@ -42,6 +43,7 @@ pub const CASES: [&str; 8] = [
     "bulkhead-longitudinal",
     "slosh-linear-potential-flow",
     "slosh-load-convergence",
+    "rest-state",
 ];
 
 /// Run a slosh case by name.
@@ -55,6 +57,7 @@ pub fn run_case(name: &str, quick: bool) -> Result<Vec<Record>> {
         "bulkhead-longitudinal" => bulkhead_longitudinal(quick),
         "slosh-linear-potential-flow" => slosh_linear_potential_flow(quick),
         "slosh-load-convergence" => slosh_load_convergence(quick),
+        "rest-state" => rest_state(quick),
         other => Err(ancf_core::error::invalid("case", other, &format!("one of {CASES:?}"))),
     }
 }
@@ -331,6 +334,112 @@ fn settled(
     run.run_to(t_settle, 0.02).map_err(|e| fail(e.to_string()))?;
     let q = run.stepper.q().to_vec();
     Ok((run.stepper.into_system(), q))
+}
+
+/// A mesh whose rest state [`rest_lambda_min`] checks.
+#[derive(Clone, Copy, Debug)]
+pub enum RestMesh {
+    /// Seed 003's rectangular tank, 0.416 × 0.324 m, water 0.132 m deep, with these element counts.
+    Box([usize; 3]),
+    /// The SwRI elliptic tank (seed 003), half full of water.
+    Swri([usize; 3]),
+    /// The tank car of seed 000 (`TankCarParams::standard`, ellipsoidal heads), half full of
+    /// light crude: the vehicle runs' cargo, with their 3³ viscous and 4³ penalty points.
+    Car([usize; 3]),
+}
+
+/// λ_min = ω²_min H/g of `mesh` about its rest state settled by dynamic relaxation (viscosity
+/// 10⁴ Pa·s, 3 s; 10 s for the tank car, whose long liquid creeps longer), with `np` force
+/// points per direction (not for the car), `ppe` contact points per face edge and the shear
+/// stabilization `stabilization` (Pa; `None`: the recommended
+/// [`rail_mbs::defaults::default_shear_stabilization`] for the mesh's element height). The
+/// linearization uses the fluid's own rheology (docs/validation.md, "A stable rest state").
+pub fn rest_lambda_min(mesh: RestMesh, np: usize, ppe: usize, stabilization: Option<f64>) -> Result<f64> {
+    use ancf_core::mesh::{EllipticCylinderSpec, elliptic_cylinder};
+    const RHO: f64 = 998.0;
+    const BOX: [f64; 3] = [0.416, 0.324, 0.132];
+    let (fluid_mesh, geo, depth, layers) = match mesh {
+        RestMesh::Box(c) => {
+            let lo = [-0.5 * BOX[0], -0.5 * BOX[1], 0.0];
+            let geo = TankGeometry::new(TankShape::Box { min: lo, max: [0.5 * BOX[0], 0.5 * BOX[1], 0.3] }, vec![])?;
+            (box_mesh(lo, BOX, c)?, geo, BOX[2], c[2])
+        }
+        RestMesh::Swri(c) => {
+            let spec = EllipticCylinderSpec::swri(c[0], c[1], c[2]);
+            let m = elliptic_cylinder(&spec)?;
+            let depth = m.liquid_depth();
+            let shape = TankShape::EllipticCylinder {
+                length: spec.length,
+                semi_axis_y: spec.semi_axis_y,
+                semi_axis_z: spec.semi_axis_z,
+            };
+            (m, TankGeometry::new(shape, vec![])?, depth, c[2])
+        }
+        RestMesh::Car(c) => {
+            let spec = rail_mbs::vehicle::TankCarParams::standard()?.tank_spec(0.5, c);
+            (cylinder_tank(&spec)?, TankGeometry::new(spec.shape(), vec![])?, spec.radius, c[2])
+        }
+    };
+    let h_el = depth / layers as f64;
+    let car = matches!(mesh, RestMesh::Car(_));
+    let (mut fluid, quadrature) = if car {
+        (rail_mbs::defaults::Oil::Light.fluid(depth, h_el)?, QuadratureOptions { viscous: 3, penalty: 4, mass: 4 })
+    } else {
+        (
+            liquid(RHO, Rheology::Newtonian { viscosity: 1e-3 }, depth, h_el)?,
+            QuadratureOptions { viscous: np, penalty: np, mass: 4 },
+        )
+    };
+    fluid.shear_stabilization =
+        stabilization.unwrap_or(rail_mbs::defaults::default_shear_stabilization(fluid.density, h_el));
+    let working = fluid.rheology;
+    let law = WallContactLaw { points_per_edge: ppe, ..WallContactLaw::default_for(fluid.density, G, depth) };
+    let settle = if car { 10.0 } else { 3.0 };
+    let (mut sys, q) = settled(fluid_mesh, fluid, geo, law, quadrature, settle)?;
+    sys.body.fluid.rheology = working;
+    let modes =
+        linear_modes(&mut sys, settle, &q).map_err(|e| AncfError::NonFinite { what: e.to_string(), element: 0 })?;
+    Ok(modes.omega_sq[0] * depth / G)
+}
+
+/// `rest-state` (issue 16 §6): λ_min ≥ 0 with the recommended shear stabilization on the
+/// default and shipped meshes, each with its quadrature.
+fn rest_state(quick: bool) -> Result<Vec<Record>> {
+    let mut meshes = vec![
+        (RestMesh::Swri([1, 2, 2]), 4, 5, "SwRI 1x2x2, 4^3 force points, 5x5 contact points (the SwRI scenes)"),
+        (RestMesh::Car([2, 2, 2]), 0, 4, "tank car 2x2x2 with heads, light crude (the braking and curving scenes)"),
+    ];
+    if !quick {
+        meshes.extend([
+            (RestMesh::Box([4, 8, 3]), 3, 3, "rectangular tank 4x8x3, 3^3, 3x3 (slosh-rect-tank full)"),
+            (RestMesh::Box([3, 6, 2]), 4, 4, "rectangular tank 3x6x2, 4^3, 4x4 (slosh-rect-tank quick)"),
+            (RestMesh::Swri([2, 4, 2]), 3, 3, "SwRI 2x4x2, 3^3, 3x3 (the default slosh scene)"),
+            (RestMesh::Swri([2, 4, 4]), 3, 3, "SwRI 2x4x4, 3^3, 3x3"),
+            (
+                RestMesh::Car([6, 4, 2]),
+                0,
+                4,
+                "tank car 6x4x2 with heads, light crude (the ECP scenes, the paper's mesh)",
+            ),
+        ]);
+    }
+    meshes
+        .into_iter()
+        .map(|(mesh, np, ppe, what)| {
+            let lam = rest_lambda_min(mesh, np, ppe, None)?;
+            Ok(Record {
+                case: "rest-state".into(),
+                quantity: format!(
+                    "rest state stable with the recommended shear stabilization: smallest eigenvalue omega^2 H/g of the \
+                     linearization about the settled state, must be >= 0, {what}"
+                ),
+                measured: lam,
+                reference: 0.0,
+                tolerance: 0.0,
+                passed: lam.is_finite() && lam >= 0.0,
+            })
+        })
+        .collect()
 }
 
 fn slosh_cylinder_half(quick: bool) -> Result<Vec<Record>> {
