@@ -18,9 +18,8 @@
 //! least-squares edge leaves the tank car's meshes an eighth to a tenth of the volume error
 //! of the secant slope (2×2×2: −0.17 % against −1.3 %; 6×4×2: −0.056 % against −0.58 %), and
 //! the liquid at rest no longer creeps into a gap at the rim (docs/validation.md, "A stable
-//! rest state"). The
-//! mesh's own volume therefore differs slightly from the exact volume of the region;
-//! [`FluidMesh::exact_volume`] keeps the latter so tests can measure the difference.
+//! rest state"). The mesh's own volume therefore differs slightly from the exact volume of
+//! the region; [`FluidMesh::exact_volume`] keeps the latter so tests can measure the difference.
 //!
 //! All shapes are given in the **tank frame**: x along the tank axis (forward), y to the
 //! left, z up, origin at the tank centre (see `docs/frames.md`).

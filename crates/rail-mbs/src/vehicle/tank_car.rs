@@ -163,8 +163,8 @@ fn beam(mass: f64, length: f64) -> BodyMass {
 }
 
 /// Depth of the tank's half-ellipsoidal heads, m: seed 000 gives a cylindrical tank "with
-/// half-ellipsoid ends" but not their depth, so this is our choice (as `python/railslosh/mesh.py`'s
-/// `TANK_CAR_HEAD_DEPTH`); the heads lie within the overall `tank_length`.
+/// half-ellipsoid ends" but not their depth, so this is our choice; the heads lie within the
+/// overall `tank_length`. Python reads it as `railslosh.mesh.TANK_CAR_HEAD_DEPTH`.
 pub const TANK_HEAD_DEPTH: f64 = 0.5;
 
 impl TankCarParams {
