@@ -616,6 +616,35 @@ def test_the_shear_stabilization_reaches_the_runs_of_vehicle_and_slosh_scenes():
             assert sc.fluid.shear_stabilization == (not path.name.startswith("swri_bump")), path.name
 
 
+def test_a_tank_with_heads_gets_the_floor_of_the_shear_stabilization():
+    """The recommended shear stabilization is 0.006 rho g h_el, and in a tank with heads at least
+    0.005 rho g H (docs/validation.md, "A stable rest state": the car meshes with three and four
+    layers are unstable with the element rule alone); slosh scenes with a cylinder tank with heads
+    apply the floor, flat-ended ones and the SwRI tank do not."""
+    rho, depth = 850.0, 1.5
+    by_element = railslosh.fluids.default_shear_stabilization(rho, depth / 3)
+    assert by_element == pytest.approx(0.006 * rho * GRAVITY * depth / 3, rel=1e-12)
+    floored = railslosh.fluids.default_shear_stabilization(rho, depth / 3, depth)
+    assert floored == pytest.approx(0.005 * rho * GRAVITY * depth, rel=1e-12) and floored > by_element
+    # one layer: the element rule is the larger
+    one_layer = railslosh.fluids.default_shear_stabilization(rho, depth, depth)
+    assert one_layer == pytest.approx(0.006 * rho * GRAVITY * depth)
+    with pytest.raises(ValueError, match="heads_depth"):
+        railslosh.fluids.default_shear_stabilization(rho, 0.5, -1.0)
+    car = {**SLOSH_BASE, "tank": {"shape": "cylinder", "length": 11.0, "radius": 1.5, "head_depth": 0.5}}
+    car = _set_dotted(car, "mesh.counts", [6, 4, 3])
+    sc = scene.load_scene(car)
+    fluid = sc.run_args()[0][1]
+    h = sc.depth()
+    assert fluid.shear_stabilization == pytest.approx(
+        railslosh.fluids.default_shear_stabilization(fluid.density, h / 3, h), rel=1e-12
+    )
+    assert fluid.shear_stabilization == pytest.approx(0.005 * fluid.density * GRAVITY * h, rel=1e-12)
+    flat = scene.load_scene(_set_dotted(car, "tank.head_depth", 0.0))
+    f_flat = flat.run_args()[0][1]
+    assert f_flat.shear_stabilization == pytest.approx(0.006 * f_flat.density * GRAVITY * flat.depth() / 3, rel=1e-12)
+
+
 def test_the_wall_adhesion_reaches_the_runs_of_vehicle_and_slosh_scenes():
     """``[tank] wall_adhesion`` (default 0, a unilateral wall) goes to run_fluid and slosh.run, reads
     back from to_dict, is refused out of [0, 50] naming the field, and does not go to the equivalent

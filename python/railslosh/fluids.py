@@ -41,12 +41,14 @@ def default_bulk_damping(bulk_penalty: float, density: float, element_height: fl
     return _core.default_bulk_damping(bulk_penalty, density, element_height)
 
 
-def default_shear_stabilization(density: float, element_height: float) -> float:
+def default_shear_stabilization(density: float, element_height: float, heads_depth: float | None = None) -> float:
     """Recommended shear stabilization G_s = 0.006 rho g h_el (Pa) for elements ``element_height``
-    m high (``rail_mbs::defaults::default_shear_stabilization``): the smallest factor, with a
-    margin, that makes the rest state of the default meshes stable; it also raises the first
-    sloshing frequency by about 0.8 % on coarse meshes (docs/validation.md)."""
-    return _core.default_shear_stabilization(density, element_height)
+    m high and, for the liquid ``heads_depth`` m deep in a tank with heads, at least 0.005 rho g H
+    (``rail_mbs::defaults::default_shear_stabilization``): the smallest factors, with a margin,
+    that make the rest state of the default meshes and of every tank-car mesh up to four layers
+    stable; it also raises the first sloshing frequency by about 0.8 % on coarse meshes and by
+    1-2 % on the tank car (docs/validation.md, "A stable rest state")."""
+    return _core.default_shear_stabilization(density, element_height, heads_depth)
 
 
 def _penalty(density: float, bulk_penalty: float | None, depth: float) -> float:

@@ -35,7 +35,8 @@ fn main() {
         fluid.rheology = Rheology::Newtonian { viscosity: 1e4 };
     }
     if stabilized {
-        fluid.shear_stabilization = default_shear_stabilization(fluid.density, depth / c[2] as f64);
+        fluid.shear_stabilization =
+            default_shear_stabilization(fluid.density, depth / c[2] as f64, (head > 0.0).then_some(depth));
     }
     let rho = fluid.density;
     let body =

@@ -84,7 +84,10 @@ fn main() {
     let mut sys = run.stepper.into_system();
     let rgh = rho * G * depth;
     // the recommended value for this mesh's element height (its fluid carries none)
-    let g_default = rail_mbs::defaults::default_shear_stabilization(rho, depth / c[2] as f64);
+    let heads = (!matches!(kind.as_str(), "swri" | "box")
+        && std::env::var("HEAD").map_or(true, |h| h.parse::<f64>().unwrap() > 0.0))
+    .then_some(depth);
+    let g_default = rail_mbs::defaults::default_shear_stabilization(rho, depth / c[2] as f64, heads);
     {
         use rail_mbs::integrator::MechanicalSystem;
         let n = sys.n_coords();

@@ -201,7 +201,7 @@ fn a_tank_at_rest_for_20_s_keeps_a_flat_energy() {
     let mesh = elliptic_cylinder(&spec).unwrap();
     let depth = mesh.liquid_depth();
     let mut fluid = liquid(RHO, Rheology::Newtonian { viscosity: 1e-3 }, depth, depth / 2.0).unwrap();
-    fluid.shear_stabilization = rail_mbs::defaults::default_shear_stabilization(RHO, depth / 2.0);
+    fluid.shear_stabilization = rail_mbs::defaults::default_shear_stabilization(RHO, depth / 2.0, None);
     let body = FluidBody::new(mesh, fluid, QuadratureOptions { viscous: 4, penalty: 4, mass: 4 }).unwrap();
     let shape = TankShape::EllipticCylinder {
         length: spec.length,

@@ -352,7 +352,8 @@ pub enum RestMesh {
 /// 10⁴ Pa·s, 3 s; 10 s for the tank car, whose long liquid creeps longer), with `np` force
 /// points per direction (not for the car), `ppe` contact points per face edge and the shear
 /// stabilization `stabilization` (Pa; `None`: the recommended
-/// [`rail_mbs::defaults::default_shear_stabilization`] for the mesh's element height). The
+/// [`rail_mbs::defaults::default_shear_stabilization`] for the mesh's element height, and for
+/// the tank car with its heads' floor). The
 /// linearization uses the fluid's own rheology (docs/validation.md, "A stable rest state").
 pub fn rest_lambda_min(mesh: RestMesh, np: usize, ppe: usize, stabilization: Option<f64>) -> Result<f64> {
     use ancf_core::mesh::{EllipticCylinderSpec, elliptic_cylinder};
@@ -390,8 +391,11 @@ pub fn rest_lambda_min(mesh: RestMesh, np: usize, ppe: usize, stabilization: Opt
             QuadratureOptions { viscous: np, penalty: np, mass: 4 },
         )
     };
-    fluid.shear_stabilization =
-        stabilization.unwrap_or(rail_mbs::defaults::default_shear_stabilization(fluid.density, h_el));
+    fluid.shear_stabilization = stabilization.unwrap_or(rail_mbs::defaults::default_shear_stabilization(
+        fluid.density,
+        h_el,
+        car.then_some(depth),
+    ));
     let working = fluid.rheology;
     let law = WallContactLaw { points_per_edge: ppe, ..WallContactLaw::default_for(fluid.density, G, depth) };
     let settle = if car { 10.0 } else { 3.0 };
@@ -421,6 +425,10 @@ fn rest_state(quick: bool) -> Result<Vec<Record>> {
                 4,
                 "tank car 6x4x2 with heads, light crude (the ECP scenes, the paper's mesh)",
             ),
+            (RestMesh::Car([6, 4, 3]), 0, 4, "tank car 6x4x3 with heads, light crude (three layers)"),
+            (RestMesh::Car([12, 6, 3]), 0, 4, "tank car 12x6x3 with heads, light crude"),
+            (RestMesh::Car([4, 8, 4]), 0, 4, "tank car 4x8x4 with heads, light crude (four layers)"),
+            (RestMesh::Car([8, 6, 4]), 0, 4, "tank car 8x6x4 with heads, light crude"),
         ]);
     }
     meshes
@@ -605,12 +613,22 @@ fn bulkhead_longitudinal(quick: bool) -> Result<Vec<Record>> {
     // braking pulse: -0.1 g (about the mean of 40 -> 5 km/h in 10 s) after 0.5 s at rest
     let mut motion = PrescribedMotion::at_rest([0.0; 3]);
     motion.translation[0] = PiecewiseAcceleration::pulse(-0.1 * G, 0.5, t_end, 0.2)?;
-    let fluid = liquid(
+    // the configuration of the vehicle runs and scenes (`FluidCargo`): 4³ penalty points, 4×4
+    // contact points, critically damped adhesive walls and the recommended shear stabilization
+    // (docs/validation.md, "bulkhead-longitudinal with the scenes' walls")
+    let mut fluid = liquid(
         850.0,
         Rheology::Oldroyd { viscosity: 0.005, yield_stress: 0.0, elastic_modulus: None },
         r,
         r / n[2] as f64,
     )?;
+    fluid.shear_stabilization =
+        rail_mbs::defaults::default_shear_stabilization(fluid.density, r / n[2] as f64, Some(r));
+    let mut law = WallContactLaw::default_for(fluid.density, G, r)
+        .with_damping_ratio(SCENE_WALL_DAMPING, fluid.density, G, r)?
+        .with_adhesion(SCENE_WALL_ADHESION, fluid.density, G, r)?;
+    law.points_per_edge = 4;
+    let quad = QuadratureOptions { penalty: 4, ..QuadratureOptions::default() };
     let mut peaks = Vec::new();
     for with in [false, true] {
         let (mesh, bulkheads) = if with {
@@ -622,7 +640,7 @@ fn bulkhead_longitudinal(quick: bool) -> Result<Vec<Record>> {
             (cylinder_tank(&spec)?, vec![])
         };
         let geo = TankGeometry::new(TankShape::Cylinder { length: l, radius: r, head_depth: hd }, bulkheads)?;
-        let (rec, mass) = run(mesh, fluid, geo, r, motion.clone(), SloshFrame::Inertial, t_end, 0.01)?;
+        let (rec, mass) = run_with(mesh, fluid, geo, law, quad, motion.clone(), SloshFrame::Inertial, t_end, 0.01)?;
         let peak = rec.force_tank.iter().map(|f| f[0].abs()).fold(0.0, f64::max);
         peaks.push(peak / (mass * 0.1 * G));
     }
@@ -793,11 +811,12 @@ struct PulseLoad {
     steps: usize,
 }
 
-/// Wall damping ratio of `slosh-load-convergence` (critical, as the shipped ECP and lane-change
-/// scenes).
-const LOAD_CONVERGENCE_WALL_DAMPING: f64 = 1.0;
-/// Wall adhesion of `slosh-load-convergence` (suction, × ρ g H): docs/validation.md, "Wall peeling".
-const LOAD_CONVERGENCE_WALL_ADHESION: f64 = 4.0;
+/// Wall damping ratio of `slosh-load-convergence` and `bulkhead-longitudinal`: critical, as in
+/// the shipped crude-oil and lane-change scenes.
+const SCENE_WALL_DAMPING: f64 = 1.0;
+/// Wall adhesion (suction, × ρ g H) of `slosh-load-convergence` and `bulkhead-longitudinal`, as in
+/// the shipped crude-oil scenes: docs/validation.md, "Wall peeling".
+const SCENE_WALL_ADHESION: f64 = 4.0;
 
 /// One run of `slosh-load-convergence`: 0.3 g lateral pulse on `counts`, steps ≤ `h`,
 /// figures of F_y over [t_a, t_b] (the run ends at t_b).
@@ -807,8 +826,8 @@ fn pulse_load(counts: [usize; 3], h: f64, t_a: f64, t_b: f64) -> Result<PulseLoa
     motion.translation[1] = PiecewiseAcceleration::pulse(0.3 * G, 0.1, 0.6, 0.02)?;
     let (mesh, fluid, geo) = rect_setup(counts)?;
     let mut law = WallContactLaw::default_for(fluid.density, G, d)
-        .with_damping_ratio(LOAD_CONVERGENCE_WALL_DAMPING, fluid.density, G, d)?
-        .with_adhesion(LOAD_CONVERGENCE_WALL_ADHESION, fluid.density, G, d)?;
+        .with_damping_ratio(SCENE_WALL_DAMPING, fluid.density, G, d)?
+        .with_adhesion(SCENE_WALL_ADHESION, fluid.density, G, d)?;
     law.points_per_edge = 4;
     let quad = QuadratureOptions { penalty: 4, ..QuadratureOptions::default() };
     let (rec, _) = run_with(mesh, fluid, geo, law, quad, motion, SloshFrame::Inertial, t_b, h)?;
@@ -900,7 +919,7 @@ fn slosh_load_convergence(quick: bool) -> Result<Vec<Record>> {
     let fine_step = pulse_load(meshes[1], h_fine, t_a, t_b)?;
     let tag = format!(
         "0.3 g lateral pulse 0.1-0.6 s (20 ms ramps), window {t_a}-{t_b} s, 4^3 penalty points, 4x4 contact \
-         points, wall damping ratio {LOAD_CONVERGENCE_WALL_DAMPING}, wall adhesion {LOAD_CONVERGENCE_WALL_ADHESION} \
+         points, wall damping ratio {SCENE_WALL_DAMPING}, wall adhesion {SCENE_WALL_ADHESION} \
          rho g H"
     );
     let fig = |r: &PulseLoad| {

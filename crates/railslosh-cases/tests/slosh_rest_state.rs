@@ -47,18 +47,27 @@ fn the_coarse_swri_mesh_needs_the_shipped_quadrature() {
 }
 
 /// Issue 16 §6: the tank car with ellipsoidal heads, on the shipped meshes (2×2×2: braking
-/// and curving scenes; 6×4×2: the paper's mesh, the ECP scenes), has a stable rest state with the
-/// recommended shear stabilization (λ_min = +0.0103 and +0.0058; the lowest mode's
-/// eigenvalue after 10 s of settling). Before the head rim's nodes had their edge fitted
-/// (`ancf_core::mesh`, secant slopes at the rim) the liquid crept into the gap the secant edge
-/// left at the rim, and the same check gave −0.0022 and −0.75. Without the stabilization the
-/// paper's mesh still has a growing mode (−0.23), so the check can fail.
+/// and curving scenes; 6×4×2: the paper's mesh, the ECP scenes) and with three layers (6×4×3),
+/// has a stable rest state with the recommended shear stabilization, whose floor for a tank with
+/// heads is 0.005 ρ g H (λ_min = +0.0185, +0.0160, +0.0148; the lowest mode's eigenvalue after
+/// 10 s of settling). Before the head rim's nodes had their edge fitted (`ancf_core::mesh`,
+/// secant slopes at the rim) the liquid crept into the gap the secant edge left at the rim, and
+/// the first two gave −0.0022 and −0.75. Without the stabilization the paper's mesh has a growing
+/// mode (−0.23), and the three-layer mesh has one with the element-height rule alone, 0.006 ρ g
+/// h_el (−0.036), so each check can fail.
 #[test]
 fn the_tank_car_with_heads_has_a_stable_rest_state() {
-    for counts in [[2, 2, 2], [6, 4, 2]] {
+    for counts in [[2, 2, 2], [6, 4, 2], [6, 4, 3]] {
         let stabilized = lambda(RestMesh::Car(counts), 0, 4, None);
         assert!(stabilized >= 0.0, "tank car {counts:?}: lambda_min = {stabilized}");
     }
     let bare = lambda(RestMesh::Car([6, 4, 2]), 0, 4, Some(0.0));
     assert!(bare < -0.01, "the tank car's 6x4x2 mesh without the stabilization was measured unstable: {bare}");
+    let light = rail_mbs::defaults::Oil::Light.fluid(1.5, 0.5).expect("light crude").density;
+    let by_element = rail_mbs::defaults::default_shear_stabilization(light, 0.5, None);
+    let element_rule = lambda(RestMesh::Car([6, 4, 3]), 0, 4, Some(by_element));
+    assert!(
+        element_rule < -0.01,
+        "the 6x4x3 car mesh with 0.006 rho g h_el alone was measured unstable: {element_rule}"
+    );
 }

@@ -208,16 +208,19 @@ fn default_bulk_damping(bulk_penalty: f64, density: f64, element_height: f64) ->
     Ok(rail_mbs::defaults::default_bulk_damping(bulk_penalty, density, element_height))
 }
 
-/// Recommended shear stabilization G_s = 0.006 ρ g h_el, Pa
+/// Recommended shear stabilization G_s = 0.006 ρ g h_el, Pa, and in a tank with heads
+/// (`heads_depth`, the liquid depth H) at least 0.005 ρ g H
 /// (`rail_mbs::defaults::default_shear_stabilization`).
 #[pyfunction]
-fn default_shear_stabilization(density: f64, element_height: f64) -> PyResult<f64> {
-    for (field, value) in [("density", density), ("element_height", element_height)] {
+#[pyo3(signature = (density, element_height, heads_depth=None))]
+fn default_shear_stabilization(density: f64, element_height: f64, heads_depth: Option<f64>) -> PyResult<f64> {
+    let depth = heads_depth.unwrap_or(0.0);
+    for (field, value) in [("density", density), ("element_height", element_height), ("heads_depth", depth)] {
         if !(value.is_finite() && value >= 0.0) {
             return Err(to_py(ancf_core::error::invalid(field, value, "a number >= 0")));
         }
     }
-    Ok(rail_mbs::defaults::default_shear_stabilization(density, element_height))
+    Ok(rail_mbs::defaults::default_shear_stabilization(density, element_height, heads_depth))
 }
 
 #[pyfunction]

@@ -40,19 +40,19 @@ class FluidSpec:
     (:func:`railslosh.fluids.default_shear_stabilization`), which makes the rest state stable
     (docs/validation.md, "A stable rest state"); on by default in scenes."""
 
-    def make_fluid(self, depth: float, element_height: float | None = None) -> Any:
+    def make_fluid(self, depth: float, element_height: float | None = None, heads: bool = False) -> Any:
         """The :class:`railslosh.Fluid` for a liquid ``depth`` m deep: penalty ``k = 1000 rho g depth``
         and, when ``element_height`` is given, bulk damping ``0.2 sqrt(k rho) element_height`` (the
         defaults of the slosh validation cases) unless the scene sets them; with
         :attr:`shear_stabilization` (and ``element_height``) also the recommended shear stabilization
-        :func:`railslosh.fluids.default_shear_stabilization`."""
+        :func:`railslosh.fluids.default_shear_stabilization`, with the floor of a tank with ``heads``."""
         rho = self.density()
         k = float(self.custom.get("bulk_penalty", fluids.default_bulk_penalty(rho, depth)))
         c = 0.0 if element_height is None else fluids.default_bulk_damping(k, rho, element_height)
         c = float(self.custom.get("bulk_damping", c))
         gs = 0.0
         if self.shear_stabilization and element_height is not None:
-            gs = fluids.default_shear_stabilization(rho, element_height)
+            gs = fluids.default_shear_stabilization(rho, element_height, depth if heads else None)
         if self.oil == "custom":
             args = {key: v for key, v in self.custom.items() if key not in ("density", "model")}
             args |= {"bulk_penalty": k, "bulk_damping": c, "shear_stabilization": gs}

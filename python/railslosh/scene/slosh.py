@@ -142,7 +142,8 @@ class SloshScene:
         if "bulk_penalty" not in spec.custom:
             k = fluids.default_bulk_penalty(spec.density(), depth) * max(1.0, self.peak_load_factor())
             spec = dataclasses.replace(spec, custom={**spec.custom, "bulk_penalty": k})
-        fluid = spec.make_fluid(depth, depth / spec.counts[2])
+        heads = self.tank.shape == "cylinder" and self.tank.dims[2] > 0.0
+        fluid = spec.make_fluid(depth, depth / spec.counts[2], heads)
         kw: dict[str, Any] = {
             "t_end": self.t_end,
             "h": self.step,

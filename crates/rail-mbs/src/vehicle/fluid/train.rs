@@ -47,7 +47,7 @@ pub struct FluidCargo {
     pub linear_solver: LinearSolverKind,
     /// Give a fluid without its own shear stabilization the recommended one
     /// ([`crate::defaults::default_shear_stabilization`] for the element height, liquid depth /
-    /// `counts[2]`): the zero-energy-mode control that makes the rest state stable
+    /// `counts[2]`, with the floor of a tank with heads): the zero-energy-mode control that makes the rest state stable
     /// (docs/validation.md, "A stable rest state"). Default false, the library's bare
     /// discretization that the validation cases measure; scenes and `railslosh.vehicle.run_fluid`
     /// default to true.
@@ -193,7 +193,8 @@ pub fn build_fluid_train(
     let mut fluid = cargo.fluid;
     if cargo.shear_stabilization && fluid.shear_stabilization == 0.0 {
         let element_height = depth / cargo.counts[2].max(1) as f64;
-        fluid.shear_stabilization = crate::defaults::default_shear_stabilization(fluid.density, element_height);
+        let heads = (spec.head_depth > 0.0).then_some(depth);
+        fluid.shear_stabilization = crate::defaults::default_shear_stabilization(fluid.density, element_height, heads);
     }
     let body = FluidBody::new(mesh, fluid, cargo.quadrature)?;
     let geometry = TankGeometry::new(
