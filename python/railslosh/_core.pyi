@@ -16,6 +16,8 @@ WALL_DAMPING_RATIO: float
 LUBRICATED_GAUGE_FACE: dict[str, float]
 GRAVITY: float
 TANK_HEAD_DEPTH: float
+TANK_CAR_LENGTH: float
+TANK_CAR_RADIUS: float
 FOOT: float
 INCH: float
 MPH: float

@@ -110,7 +110,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     body = rs.FluidBody(mesh, oil)
     m_exact = oil.density * mesh.exact_volume
     print(
-        f"  tank: shell {rs.mesh.TANK_CAR_LENGTH} m, radius {rs.mesh.TANK_CAR_RADIUS} m, "
+        f"  tank: shell {rs.mesh.TANK_CAR_SHELL_LENGTH} m, radius {rs.mesh.TANK_CAR_RADIUS} m, "
         f"heads {rs.mesh.TANK_CAR_HEAD_DEPTH} m, fill {args.fill:.0%} by volume, liquid depth {depth:.3f} m"
     )
     print(f"  paper mesh: {mesh.n_elements} ANCF bricks, {mesh.n_nodes} nodes, {mesh.n_coords} coordinates")
@@ -125,7 +125,9 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
     # braking: the car decelerates at 0.1 g (about 40 -> 5 km/h in 10 s) from t = 0.2 s
     run_mesh = rs.mesh.cylinder_tank(fill=args.fill, n_length=args.n_length, n_width=2, n_height=2)
-    tank = rs.slosh.TankGeometry.cylinder(rs.mesh.TANK_CAR_LENGTH, rs.mesh.TANK_CAR_RADIUS, rs.mesh.TANK_CAR_HEAD_DEPTH)
+    tank = rs.slosh.TankGeometry.cylinder(
+        rs.mesh.TANK_CAR_SHELL_LENGTH, rs.mesh.TANK_CAR_RADIUS, rs.mesh.TANK_CAR_HEAD_DEPTH
+    )
     motion = rs.slosh.Motion().pulse("x", -0.1 * GRAVITY, 0.2, 100.0, ramp=0.2)
     print(
         f"  braking run: -0.1 g from t = 0.2 s for {args.t_end} s, {run_mesh.n_elements} bricks "

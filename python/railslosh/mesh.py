@@ -12,13 +12,18 @@ import math
 from railslosh import _core, limits
 from railslosh._core import FluidMesh
 
-#: Tank of the crude-oil study (seed 000 §8.1): shell about 12 m long, radius 1.5 m.
-TANK_CAR_LENGTH = 12.0
-TANK_CAR_RADIUS = 1.5
 #: Head depth of the tank car. The paper gives none; 0.5 m is a typical 2:1-type
 #: semi-ellipsoidal head depth for a 3 m diameter DOT-111/117 car (R/3). The vehicle runs' value,
-#: ``rail_mbs::vehicle::TANK_HEAD_DEPTH``.
+#: ``ancf_core::mesh::TANK_CAR_HEAD_DEPTH``.
 TANK_CAR_HEAD_DEPTH: float = _core.TANK_HEAD_DEPTH
+#: Tank of the crude-oil study (seed 000 §8.1, "a length of approximately 12 m", radius 1.5 m): the
+#: vehicle runs' tank, 12 m overall, so its shell between the heads is 11 m long
+#: (``ancf_core::mesh::TANK_CAR_LENGTH`` and ``TANK_CAR_RADIUS``, the one home of these numbers).
+TANK_CAR_SHELL_LENGTH: float = _core.TANK_CAR_LENGTH - 2.0 * TANK_CAR_HEAD_DEPTH
+TANK_CAR_RADIUS: float = _core.TANK_CAR_RADIUS
+#: Deprecated alias (one release) of :data:`TANK_CAR_SHELL_LENGTH`, the shell length; until
+#: 2026-11-26 it was 12 m, a 13 m tank overall, 1 m longer than the vehicle runs' tank.
+TANK_CAR_LENGTH: float = TANK_CAR_SHELL_LENGTH
 
 #: SwRI elliptical tank of seed 003 appendix C: 22.9845 y^2 + 57.2785 z^2 = 1, L = 0.324 m.
 SWRI_SEMI_AXIS_Y = 1.0 / math.sqrt(22.9845)
@@ -42,7 +47,7 @@ def box(
 
 def cylinder_tank(
     *,
-    length: float = TANK_CAR_LENGTH,
+    length: float = TANK_CAR_SHELL_LENGTH,
     radius: float = TANK_CAR_RADIUS,
     head_depth: float = TANK_CAR_HEAD_DEPTH,
     fill: float = 0.5,

@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from railslosh import _core, results, scene
+from railslosh import _core, mesh, results, scene
 from railslosh.limits import invalid, suggest
 from railslosh.scene.load import parse_value, set_dotted
 from railslosh.slosh import SimulationError
@@ -76,10 +76,10 @@ def _set(over: dict[str, Any], dotted: str, value: Any) -> None:
     set_dotted(over, dotted, value, option=f"--grid {dotted}")
 
 
-def _bulkheads(n: Any, tank_length: float = 12.0) -> list[list[float]]:
+def _bulkheads(n: Any, tank_length: float = _core.TANK_CAR_LENGTH) -> list[list[float]]:
     if isinstance(n, bool) or not isinstance(n, int) or not 0 <= n <= 5:
         raise invalid("bulkheads", n, "a number of equally spaced bulkheads from 0 to 5")
-    shell = tank_length - 1.0
+    shell = tank_length - 2.0 * mesh.TANK_CAR_HEAD_DEPTH
     return [[round(-shell / 2 + shell * (k + 1) / (n + 1), 6), 0.02] for k in range(n)]
 
 
@@ -93,10 +93,13 @@ def grid_overrides(base: Mapping[str, Any], point: Mapping[str, Any]) -> dict[st
                 raise invalid("braking", value, f"one of {', '.join(_BRAKING)}")
             _set(over, "brake.scope", _BRAKING[value])
         elif name == "bulkheads":
-            # overall tank length: the car's (shell + two 0.5 m heads) or a slosh tank's shell + 1 m
-            length = float(base.get("tank", {}).get("length", 11.0)) + 1.0 if slosh else 12.0
-            if not slosh and isinstance(base.get("car"), Mapping):
-                length = float(base["car"].get("tank_length", 12.0))
+            # overall tank length: the car's (shell + two heads) or a slosh tank's shell + two heads
+            if slosh:
+                shell = float(base.get("tank", {}).get("length", mesh.TANK_CAR_SHELL_LENGTH))
+                length = shell + 2.0 * mesh.TANK_CAR_HEAD_DEPTH
+            else:
+                car = base.get("car") if isinstance(base.get("car"), Mapping) else {}
+                length = float(car.get("tank_length", _core.TANK_CAR_LENGTH))
             _set(over, "tank.bulkheads", _bulkheads(value, length))
         elif name == "speed" and slosh:
             over.setdefault("maneuver", {}).update({"speed": None, "speed_mph": None, "speed_kmh": value})

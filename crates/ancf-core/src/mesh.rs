@@ -379,14 +379,28 @@ pub struct CylinderTankSpec {
     pub grading: f64,
 }
 
+/// Overall length of the tank car's tank of seed 000 §8.1, heads included ("a length of
+/// approximately 12 m"), m: the one home of the tank car's dimensions, read by
+/// [`CylinderTankSpec::tank_car`], `rail_mbs::vehicle::TankCarParams::standard` and Python's
+/// `railslosh.mesh`.
+pub const TANK_CAR_LENGTH: f64 = 12.0;
+/// Shell radius of the tank car's tank (seed 000 §8.1: 1.5 m), m.
+pub const TANK_CAR_RADIUS: f64 = 1.5;
+/// Depth of each of the tank car's half-ellipsoidal heads, m: seed 000 gives a cylindrical tank
+/// "with half-ellipsoid ends" but not their depth, so this is our choice (R/3, a typical 2:1-type
+/// head for a 3 m diameter DOT-111/117 car); the heads lie within [`TANK_CAR_LENGTH`].
+pub const TANK_CAR_HEAD_DEPTH: f64 = 0.5;
+
 impl CylinderTankSpec {
-    /// The half-full tank car of seed 000 §8.1 (12 m shell, radius 1.5 m; head depth 0.5 m,
-    /// our choice, see `python/railslosh/mesh.py`) with the given element counts.
+    /// The half-full tank car of seed 000 §8.1 ([`TANK_CAR_LENGTH`] overall: a shell of
+    /// `TANK_CAR_LENGTH − 2·TANK_CAR_HEAD_DEPTH` = 11 m between its heads; [`TANK_CAR_RADIUS`],
+    /// [`TANK_CAR_HEAD_DEPTH`]) with the given element counts: the vehicle runs' tank
+    /// (`rail_mbs::vehicle::TankCarParams::tank_spec`).
     pub fn tank_car(counts: [usize; 3]) -> Self {
         Self {
-            length: 12.0,
-            radius: 1.5,
-            head_depth: 0.5,
+            length: TANK_CAR_LENGTH - 2.0 * TANK_CAR_HEAD_DEPTH,
+            radius: TANK_CAR_RADIUS,
+            head_depth: TANK_CAR_HEAD_DEPTH,
             fill: 0.5,
             n_length: counts[0],
             n_width: counts[1],

@@ -32,8 +32,7 @@ fn main() {
         let mesh = cylinder_tank(&spec).unwrap();
         let fluid = liquid(850.0, Rheology::Newtonian { viscosity: 0.005 }, 1.5, 1.5 / n[2] as f64).unwrap();
         let body = FluidBody::new(mesh, fluid, QuadratureOptions::default()).unwrap();
-        let geo =
-            TankGeometry::new(TankShape::Cylinder { length: 12.0, radius: 1.5, head_depth: 0.5 }, vec![]).unwrap();
+        let geo = TankGeometry::new(spec.shape(), vec![]).unwrap();
         let contact = WallContact::new(&body, geo, WallContactLaw::default_for(850.0, G, 1.5)).unwrap();
         let mut motion = PrescribedMotion::at_rest([0.0; 3]);
         motion.translation[0] = PiecewiseAcceleration::pulse(-0.1 * G, 0.2, 100.0, 0.2).unwrap();

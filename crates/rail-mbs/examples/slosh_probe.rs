@@ -29,12 +29,7 @@ fn main() {
         )
     } else {
         let spec = CylinderTankSpec::tank_car([6, 4, 2]);
-        (
-            cylinder_tank(&spec).unwrap(),
-            TankGeometry::new(TankShape::Cylinder { length: 12.0, radius: 1.5, head_depth: 0.5 }, vec![]).unwrap(),
-            1.5,
-            0.75,
-        )
+        (cylinder_tank(&spec).unwrap(), TankGeometry::new(spec.shape(), vec![]).unwrap(), 1.5, 0.75)
     };
     let k = 1000.0 * rho * 9.81 * depth;
     let mut fluid = Fluid::new(rho, Rheology::Newtonian { viscosity: mu }, k).unwrap();

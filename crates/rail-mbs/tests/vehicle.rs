@@ -11,6 +11,20 @@ fn tangent() -> Arc<Track> {
     Arc::new(Track::straight(3000.0).unwrap())
 }
 
+/// One tank car: the slosh cases' and Python's `CylinderTankSpec::tank_car` is the vehicle runs'
+/// tank (12 m overall with its heads, so an 11 m shell; until 2026-11-26 the slosh side had a
+/// 12 m shell, a tank 1 m longer than the vehicle's).
+#[test]
+fn the_slosh_tank_car_is_the_vehicle_runs_tank() {
+    let car = TankCarParams::standard().unwrap();
+    for counts in [[2, 2, 2], [6, 4, 2]] {
+        assert_eq!(car.tank_spec(0.5, counts), ancf_core::mesh::CylinderTankSpec::tank_car(counts));
+    }
+    let spec = ancf_core::mesh::CylinderTankSpec::tank_car([6, 4, 2]);
+    assert_eq!(spec.length + 2.0 * spec.head_depth, car.tank_length);
+    assert_eq!((car.tank_length, car.tank_radius), (12.0, 1.5));
+}
+
 #[test]
 fn tank_car_and_train_have_the_documented_structure() {
     let sc = TrainScenario::single(TankCarParams::standard().unwrap(), tangent(), 100.0, 0.0, 1.0);

@@ -94,7 +94,7 @@ fn element_mass() -> Result<Vec<Record>> {
         out.push(Record::abs(
             c,
             format!(
-                "half-full tank car (12 m + heads, R 1.5 m), {}x{}x{}: relative error of total mass vs rho V_exact",
+                "half-full tank car (12 m with its heads, R 1.5 m), {}x{}x{}: relative error of total mass vs rho V_exact",
                 n[0], n[1], n[2]
             ),
             body.total_mass() / (850.0 * body.mesh.exact_volume) - 1.0,

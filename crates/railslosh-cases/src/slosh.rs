@@ -110,12 +110,12 @@ fn mean_tail(x: &[f64], frac: f64) -> f64 {
 
 fn hydrostatic_cylinder(quick: bool) -> Result<Vec<Record>> {
     let c = "hydrostatic-cylinder";
-    let (r, l, hd) = (1.5, 12.0, 0.5);
     let (n, t_end) = if quick { ([4, 2, 2], 1.5) } else { ([6, 4, 2], 3.0) };
     let spec = CylinderTankSpec::tank_car(n);
+    let (r, l, hd) = (spec.radius, spec.length, spec.head_depth);
     let mesh = cylinder_tank(&spec)?;
     let fluid = liquid(850.0, Rheology::Newtonian { viscosity: 0.005 }, r, r / n[2] as f64)?;
-    let geo = TankGeometry::new(TankShape::Cylinder { length: l, radius: r, head_depth: hd }, vec![])?;
+    let geo = TankGeometry::new(spec.shape(), vec![])?;
     let v_exact = mesh.exact_volume;
     let (rec, mass) = run(mesh, fluid, geo, r, PrescribedMotion::at_rest([0.0; 3]), SloshFrame::Inertial, t_end, 0.01)?;
     let w = mass * G;
@@ -606,9 +606,9 @@ fn slosh_viscous_decay(quick: bool) -> Result<Vec<Record>> {
 
 fn bulkhead_longitudinal(quick: bool) -> Result<Vec<Record>> {
     let c = "bulkhead-longitudinal";
-    let (r, l, hd) = (1.5, 12.0, 0.5);
     let (n, t_end) = if quick { ([6, 2, 2], 5.0) } else { ([9, 4, 2], 8.0) };
     let spec = CylinderTankSpec::tank_car(n);
+    let r = spec.radius;
     let cuts = [(-2.0, 0.02), (2.0, 0.02)];
     // braking pulse: -0.1 g (about the mean of 40 -> 5 km/h in 10 s) after 0.5 s at rest
     let mut motion = PrescribedMotion::at_rest([0.0; 3]);
@@ -639,7 +639,7 @@ fn bulkhead_longitudinal(quick: bool) -> Result<Vec<Record>> {
         } else {
             (cylinder_tank(&spec)?, vec![])
         };
-        let geo = TankGeometry::new(TankShape::Cylinder { length: l, radius: r, head_depth: hd }, bulkheads)?;
+        let geo = TankGeometry::new(spec.shape(), bulkheads)?;
         let (rec, mass) = run_with(mesh, fluid, geo, law, quad, motion.clone(), SloshFrame::Inertial, t_end, 0.01)?;
         let peak = rec.force_tank.iter().map(|f| f[0].abs()).fold(0.0, f64::max);
         peaks.push(peak / (mass * 0.1 * G));

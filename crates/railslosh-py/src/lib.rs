@@ -768,6 +768,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("WALL_DAMPING_RATIO", ancf_core::contact::WALL_DAMPING_RATIO)?;
     m.add("GRAVITY", ancf_core::constants::GRAVITY)?;
     m.add("TANK_HEAD_DEPTH", rail_mbs::vehicle::TANK_HEAD_DEPTH)?;
+    m.add("TANK_CAR_LENGTH", ancf_core::mesh::TANK_CAR_LENGTH)?;
+    m.add("TANK_CAR_RADIUS", ancf_core::mesh::TANK_CAR_RADIUS)?;
     m.add("FOOT", ancf_core::constants::FOOT)?;
     m.add("INCH", ancf_core::constants::INCH)?;
     m.add("MPH", ancf_core::constants::MPH)?;

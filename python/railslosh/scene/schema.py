@@ -381,7 +381,7 @@ SCHEMA: dict[str, dict[str, dict[str, Field]]] = {
             "semi_axis_z": _num(0.02, 5.0, "m", "a length", mesh.SWRI_SEMI_AXIS_Z, "half height"),
         },
         "tank:cylinder": {
-            "length": _num(0.1, 50.0, "m", "a length", mesh.TANK_CAR_LENGTH, "shell length (default: tank car)"),
+            "length": _num(0.1, 50.0, "m", "a length", mesh.TANK_CAR_SHELL_LENGTH, "shell length (default: tank car)"),
             "radius": _num(0.05, 5.0, "m", "a length", mesh.TANK_CAR_RADIUS, "shell radius"),
             "head_depth": _num(0.0, 5.0, "m", "a length", mesh.TANK_CAR_HEAD_DEPTH, "head depth (≤ radius)"),
             "bulkheads": _BULKHEADS,

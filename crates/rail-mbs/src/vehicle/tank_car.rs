@@ -162,10 +162,10 @@ fn beam(mass: f64, length: f64) -> BodyMass {
     BodyMass { mass, inertia: [0.01 * i + 1.0, i, i] }
 }
 
-/// Depth of the tank's half-ellipsoidal heads, m: seed 000 gives a cylindrical tank "with
-/// half-ellipsoid ends" but not their depth, so this is our choice; the heads lie within the
-/// overall `tank_length`. Python reads it as `railslosh.mesh.TANK_CAR_HEAD_DEPTH`.
-pub const TANK_HEAD_DEPTH: f64 = 0.5;
+/// Depth of the tank's half-ellipsoidal heads, m ([`ancf_core::mesh::TANK_CAR_HEAD_DEPTH`], our
+/// choice: seed 000 gives none); the heads lie within the overall `tank_length`. Python reads it
+/// as `railslosh.mesh.TANK_CAR_HEAD_DEPTH`.
+pub const TANK_HEAD_DEPTH: f64 = ancf_core::mesh::TANK_CAR_HEAD_DEPTH;
 
 impl TankCarParams {
     /// The liquid of this car's tank (shell `tank_length − 2·TANK_HEAD_DEPTH` between
@@ -186,7 +186,7 @@ impl TankCarParams {
 
     /// The defaults listed on each field.
     pub fn standard() -> Result<Self, AncfError> {
-        let (m, r, l): (f64, f64, f64) = (15_000.0, 1.5, 12.0);
+        let (m, r, l): (f64, f64, f64) = (15_000.0, ancf_core::mesh::TANK_CAR_RADIUS, ancf_core::mesh::TANK_CAR_LENGTH);
         let shell = BodyMass {
             mass: m,
             inertia: [m * r * r, m * (r * r / 2.0 + l * l / 12.0), m * (r * r / 2.0 + l * l / 12.0)],
