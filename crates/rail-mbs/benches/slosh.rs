@@ -14,7 +14,7 @@ use ancf_core::constitutive::Rheology;
 use ancf_core::contact::{WallContact, WallContactLaw};
 use ancf_core::element::QuadratureOptions;
 use ancf_core::mesh::{CylinderTankSpec, cylinder_tank};
-use ancf_core::tank::{TankGeometry, TankShape};
+use ancf_core::tank::TankGeometry;
 use rail_mbs::defaults::{liquid, slosh_params};
 use rail_mbs::slosh::{PiecewiseAcceleration, PrescribedMotion, SloshFrame, SloshRun, SloshSystem};
 
