@@ -85,7 +85,8 @@ _DESCRIPTIONS = {
     "curve-outward-inertia": "one car on the Table 1 curve at 60 and 100 km/h: outward inertia force of the oil vs the "
     "in-plane gravity component, growing with density",
     "mesh-convergence": "one car braking with light crude on three meshes: oil centre-of-mass trajectories agree",
-    "coupler-force-convergence": "two cars braking (ECP and conventional) with light crude: peak of the low-passed "
+    "coupler-force-convergence": "two cars braking (ECP with identical brakes and with a 10 % weaker rear brake, "
+    "conventional) with light crude: peak of the low-passed "
     "coupler force, its RMS and steady mean change <= 5 % between the two finest of three meshes and two steps",
     "klingel-wavelength": "kinematic (no-slip) free coned wheelset: lateral oscillation wavelength vs Klingel's "
     "2 pi sqrt(r0 b / lambda)",
