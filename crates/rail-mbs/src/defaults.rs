@@ -66,12 +66,12 @@ pub const HEADS_SHEAR_STABILIZATION: f64 = 0.005;
 /// On the rectangular and elliptic tanks the unstable rest modes it removes are discretization
 /// errors that shrink as the mesh is refined, so G_s shrinks with the element; the factor is the
 /// smallest that made the rest state of the rectangular tank's 4×8×3 mesh stable, with a margin.
-/// The liquid of a tank with heads is meshed by stretching each axial fibre from head to head,
-/// a map whose slope is singular (√) wherever the fibre meets the shell; there the growing modes
-/// do not shrink with refinement but grow with the number of layers (λ_min with the element-
-/// height rule: 6×4×3 −0.036, 4×8×4 −1.62), and the floor 0.005 ρ g H, the smallest stable
-/// multiple of ρ g H on the 6×4×3 mesh (0.003: −0.0016; 0.004: +0.0092) with a margin, makes
-/// every car mesh from 2×2×2 to 8×6×4 stable (docs/validation.md, "A stable rest state").
+/// In a tank with heads the growing modes do not shrink with refinement but grow with the
+/// number of layers (λ_min with the element-height rule: 6×4×3 −0.036, 4×8×4 −1.62; they sit
+/// where the free surface meets the shell and at the section map's 180° corners, and the
+/// flat-ended meshes do not have them), and the floor 0.005 ρ g H, 25 % above the smallest
+/// multiple of ρ g H that makes them all stable (0.004), makes every car mesh from 2×2×2 to
+/// 8×6×4 stable (docs/validation.md, "A stable rest state").
 ///
 /// It is not applied by default: it also stiffens the sloshing (first frequency +0.8 % on the
 /// 2×6×2 rectangular tank, +1.0 to +2.1 % on the car meshes), so runs opt in (scene key

@@ -47,8 +47,9 @@ pub struct FluidCargo {
     pub linear_solver: LinearSolverKind,
     /// Give a fluid without its own shear stabilization the recommended one
     /// ([`crate::defaults::default_shear_stabilization`] for the element height, liquid depth /
-    /// `counts[2]`, with the floor of a tank with heads): the zero-energy-mode control that makes the rest state stable
-    /// (docs/validation.md, "A stable rest state"). Default false, the library's bare
+    /// `counts[2]`, with the floor of a tank with heads): the zero-energy-mode control that
+    /// makes the rest state stable (docs/validation.md, "A stable rest state"). Default false,
+    /// the library's bare
     /// discretization that the validation cases measure; scenes and `railslosh.vehicle.run_fluid`
     /// default to true.
     pub shear_stabilization: bool,
