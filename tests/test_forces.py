@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 import railslosh as rs
@@ -56,6 +56,7 @@ def test_rigid_motion_gives_zero_force_and_forces_rotate(model, rng):
 
 @settings(max_examples=6, deadline=None)
 @given(model=st.sampled_from(sorted(MODELS)), seed=st.integers(0, 2**31), amp=st.floats(0.0, 0.04))
+@example(model="bingham", seed=189, amp=1.192092896e-07)  # found by hypothesis on 2026-11-26
 def test_element_jacobians_match_central_differences(model, seed, amp):
     body = make_body(model)
     rng = np.random.default_rng(seed)
@@ -63,7 +64,12 @@ def test_element_jacobians_match_central_differences(model, seed, amp):
     v = 0.5 * rng.uniform(-1, 1, 96)
     dofs = body.element_dofs(0)
     f, k, c = body.element_tangent(0, e, v)
-    np.testing.assert_allclose(f, body.internal_forces(e, v)[dofs], rtol=1e-12, atol=1e-12)
+    # The two paths sum the same terms in a different order. Near the reference state the penalty
+    # terms, of order k V = 2e5 Pa * 0.03 m^3 = 6 kN, cancel to forces of order 1 N, so the paths
+    # agree to round-off of k V, not of |f| (seed 189, amp 1.2e-7: 2.1e-12 N, 1.6 ulps of k V, on
+    # forces up to 2.2 N): the tolerance is 64 ulps of k V.
+    atol = 64 * np.finfo(float).eps * 2.0e5 * 0.5 * 0.3 * 0.2
+    np.testing.assert_allclose(f, body.internal_forces(e, v)[dofs], rtol=1e-12, atol=atol)
     h = 1e-6
     for jac, wrt in ((k, "e"), (c, "v")):
         fd = np.empty((96, 96))
