@@ -29,7 +29,7 @@ use rail_mbs::slosh::{
     PiecewiseAcceleration, PrescribedMotion, SloshFrame, SloshRecord, SloshRun, SloshSystem, linear_modes,
 };
 
-use crate::Record;
+use crate::{Record, SCENE_WALL_ADHESION, SCENE_WALL_DAMPING};
 
 use ancf_core::constants::GRAVITY as G;
 
@@ -315,15 +315,16 @@ fn transverse_model(
 /// 10⁴ Pa·s (ν ≈ 10 m²/s: the viscous rate ν(π/R)² ≈ 44 1/s of a 1.5 m section is far above
 /// its sloshing frequencies, so every motion is overdamped) and the tank stays at rest for
 /// `t_settle`. The equilibrium does not depend on the viscosity. Returns the system (with
-/// the raised viscosity) and the settled coordinates.
-fn settled(
+/// the raised viscosity), the settled coordinates and their velocities (what is left of the
+/// creep).
+pub fn settled(
     mesh: FluidMesh,
     mut fluid: Fluid,
     geo: TankGeometry,
     law: WallContactLaw,
     quadrature: QuadratureOptions,
     t_settle: f64,
-) -> Result<(SloshSystem, Vec<f64>)> {
+) -> Result<(SloshSystem, Vec<f64>, Vec<f64>)> {
     fluid.rheology = Rheology::Newtonian { viscosity: 1e4 };
     let body = FluidBody::new(mesh, fluid, quadrature)?;
     let contact = WallContact::new(&body, geo, law)?;
@@ -332,8 +333,8 @@ fn settled(
     let fail = |e: String| AncfError::NonFinite { what: e, element: 0 };
     let mut run = SloshRun::new(sys, 0.0, slosh_params()).map_err(|e| fail(e.to_string()))?;
     run.run_to(t_settle, 0.02).map_err(|e| fail(e.to_string()))?;
-    let q = run.stepper.q().to_vec();
-    Ok((run.stepper.into_system(), q))
+    let (q, v) = (run.stepper.q().to_vec(), run.stepper.v().to_vec());
+    Ok((run.stepper.into_system(), q, v))
 }
 
 /// A mesh whose rest state [`rest_lambda_min`] checks.
@@ -348,6 +349,90 @@ pub enum RestMesh {
     Car([usize; 3]),
 }
 
+/// The model of a [`RestMesh`] ([`RestMesh::tank`]): its liquid mesh, tank, liquid (with its own
+/// rheology, no shear stabilization) and depth.
+#[derive(Debug, Clone)]
+pub struct RestTank {
+    /// The liquid's mesh in its reference (flat-surface) state.
+    pub mesh: FluidMesh,
+    /// The tank's walls.
+    pub geometry: TankGeometry,
+    /// The liquid ([`liquid`] or the light crude), shear stabilization 0.
+    pub fluid: Fluid,
+    /// Liquid depth H (m).
+    pub depth: f64,
+    /// Liquid depth over the mesh's element layers (m).
+    pub element_height: f64,
+    /// A tank with heads (the floor of the recommended shear stabilization applies).
+    pub heads: bool,
+}
+
+impl RestTank {
+    /// The recommended shear stabilization of this model ([`rail_mbs::defaults::default_shear_stabilization`]).
+    pub fn recommended_stabilization(&self) -> f64 {
+        rail_mbs::defaults::default_shear_stabilization(
+            self.fluid.density,
+            self.element_height,
+            self.heads.then_some(self.depth),
+        )
+    }
+
+    /// The library's wall law with `ppe` contact points per face edge.
+    pub fn wall_law(&self, ppe: usize) -> WallContactLaw {
+        WallContactLaw { points_per_edge: ppe, ..WallContactLaw::default_for(self.fluid.density, G, self.depth) }
+    }
+}
+
+impl RestMesh {
+    /// The model ([`RestTank`]). `head_depth` replaces the tank car's head depth (0: flat ends,
+    /// the shell as long as the whole tank); ignored for the other tanks.
+    pub fn tank(self, head_depth: Option<f64>) -> Result<RestTank> {
+        use ancf_core::mesh::{EllipticCylinderSpec, elliptic_cylinder};
+        const RHO: f64 = 998.0;
+        const BOX: [f64; 3] = [0.416, 0.324, 0.132];
+        let water = |depth: f64, layers: usize| {
+            liquid(RHO, Rheology::Newtonian { viscosity: 1e-3 }, depth, depth / layers as f64)
+        };
+        let (mesh, geometry, depth, layers, fluid, heads) = match self {
+            RestMesh::Box(c) => {
+                let lo = [-0.5 * BOX[0], -0.5 * BOX[1], 0.0];
+                let geo =
+                    TankGeometry::new(TankShape::Box { min: lo, max: [0.5 * BOX[0], 0.5 * BOX[1], 0.3] }, vec![])?;
+                (box_mesh(lo, BOX, c)?, geo, BOX[2], c[2], water(BOX[2], c[2])?, false)
+            }
+            RestMesh::Swri(c) => {
+                let spec = EllipticCylinderSpec::swri(c[0], c[1], c[2]);
+                let m = elliptic_cylinder(&spec)?;
+                let depth = m.liquid_depth();
+                let shape = TankShape::EllipticCylinder {
+                    length: spec.length,
+                    semi_axis_y: spec.semi_axis_y,
+                    semi_axis_z: spec.semi_axis_z,
+                };
+                (m, TankGeometry::new(shape, vec![])?, depth, c[2], water(depth, c[2])?, false)
+            }
+            RestMesh::Car(c) => {
+                let p = rail_mbs::vehicle::TankCarParams::standard()?;
+                let mut spec = p.tank_spec(0.5, c);
+                if let Some(head) = head_depth {
+                    spec = CylinderTankSpec { length: p.tank_length - 2.0 * head, head_depth: head, ..spec };
+                }
+                let depth = spec.radius;
+                let fluid = rail_mbs::defaults::Oil::Light.fluid(depth, depth / c[2] as f64)?;
+                (
+                    cylinder_tank(&spec)?,
+                    TankGeometry::new(spec.shape(), vec![])?,
+                    depth,
+                    c[2],
+                    fluid,
+                    spec.head_depth > 0.0,
+                )
+            }
+        };
+        Ok(RestTank { mesh, geometry, fluid, depth, element_height: depth / layers as f64, heads })
+    }
+}
+
 /// λ_min = ω²_min H/g of `mesh` about its rest state settled by dynamic relaxation (viscosity
 /// 10⁴ Pa·s, 3 s; 10 s for the tank car, whose long liquid creeps longer), with `np` force
 /// points per direction (not for the car), `ppe` contact points per face edge and the shear
@@ -356,54 +441,23 @@ pub enum RestMesh {
 /// the tank car with its heads' floor). The
 /// linearization uses the fluid's own rheology (docs/validation.md, "A stable rest state").
 pub fn rest_lambda_min(mesh: RestMesh, np: usize, ppe: usize, stabilization: Option<f64>) -> Result<f64> {
-    use ancf_core::mesh::{EllipticCylinderSpec, elliptic_cylinder};
-    const RHO: f64 = 998.0;
-    const BOX: [f64; 3] = [0.416, 0.324, 0.132];
-    let (fluid_mesh, geo, depth, layers) = match mesh {
-        RestMesh::Box(c) => {
-            let lo = [-0.5 * BOX[0], -0.5 * BOX[1], 0.0];
-            let geo = TankGeometry::new(TankShape::Box { min: lo, max: [0.5 * BOX[0], 0.5 * BOX[1], 0.3] }, vec![])?;
-            (box_mesh(lo, BOX, c)?, geo, BOX[2], c[2])
-        }
-        RestMesh::Swri(c) => {
-            let spec = EllipticCylinderSpec::swri(c[0], c[1], c[2]);
-            let m = elliptic_cylinder(&spec)?;
-            let depth = m.liquid_depth();
-            let shape = TankShape::EllipticCylinder {
-                length: spec.length,
-                semi_axis_y: spec.semi_axis_y,
-                semi_axis_z: spec.semi_axis_z,
-            };
-            (m, TankGeometry::new(shape, vec![])?, depth, c[2])
-        }
-        RestMesh::Car(c) => {
-            let spec = rail_mbs::vehicle::TankCarParams::standard()?.tank_spec(0.5, c);
-            (cylinder_tank(&spec)?, TankGeometry::new(spec.shape(), vec![])?, spec.radius, c[2])
-        }
-    };
-    let h_el = depth / layers as f64;
+    let tank = mesh.tank(None)?;
     let car = matches!(mesh, RestMesh::Car(_));
-    let (mut fluid, quadrature) = if car {
-        (rail_mbs::defaults::Oil::Light.fluid(depth, h_el)?, QuadratureOptions { viscous: 3, penalty: 4, mass: 4 })
+    let quadrature = if car {
+        QuadratureOptions { viscous: 3, penalty: 4, mass: 4 }
     } else {
-        (
-            liquid(RHO, Rheology::Newtonian { viscosity: 1e-3 }, depth, h_el)?,
-            QuadratureOptions { viscous: np, penalty: np, mass: 4 },
-        )
+        QuadratureOptions { viscous: np, penalty: np, mass: 4 }
     };
-    fluid.shear_stabilization = stabilization.unwrap_or(rail_mbs::defaults::default_shear_stabilization(
-        fluid.density,
-        h_el,
-        car.then_some(depth),
-    ));
+    let law = tank.wall_law(ppe);
+    let mut fluid = tank.fluid;
+    fluid.shear_stabilization = stabilization.unwrap_or(tank.recommended_stabilization());
     let working = fluid.rheology;
-    let law = WallContactLaw { points_per_edge: ppe, ..WallContactLaw::default_for(fluid.density, G, depth) };
     let settle = if car { 10.0 } else { 3.0 };
-    let (mut sys, q) = settled(fluid_mesh, fluid, geo, law, quadrature, settle)?;
+    let (mut sys, q, _) = settled(tank.mesh, fluid, tank.geometry, law, quadrature, settle)?;
     sys.body.fluid.rheology = working;
     let modes =
         linear_modes(&mut sys, settle, &q).map_err(|e| AncfError::NonFinite { what: e.to_string(), element: 0 })?;
-    Ok(modes.omega_sq[0] * depth / G)
+    Ok(modes.omega_sq[0] * tank.depth / G)
 }
 
 /// `rest-state` (issue 16 §6): λ_min ≥ 0 with the recommended shear stabilization on the
@@ -462,7 +516,7 @@ fn slosh_cylinder_half(quick: bool) -> Result<Vec<Record>> {
     let tag = format!("mesh {counts:?}, 4^3 penalty points, 4x4 contact points, walls 100x stiffer");
     let (mesh, fluid, geo, law, quad) = transverse_model(counts, water)?;
     let t_settle = 4.0;
-    let (mut sys, q) = settled(mesh, fluid, geo, law, quad, t_settle)?;
+    let (mut sys, q, _) = settled(mesh, fluid, geo, law, quad, t_settle)?;
     let mass = sys.body.total_mass();
     let modes =
         linear_modes(&mut sys, t_settle, &q).map_err(|e| AncfError::NonFinite { what: e.to_string(), element: 0 })?;
@@ -810,13 +864,6 @@ struct PulseLoad {
     /// Accepted steps.
     steps: usize,
 }
-
-/// Wall damping ratio of `slosh-load-convergence` and `bulkhead-longitudinal`: critical, as in
-/// the shipped crude-oil and lane-change scenes.
-const SCENE_WALL_DAMPING: f64 = 1.0;
-/// Wall adhesion (suction, × ρ g H) of `slosh-load-convergence` and `bulkhead-longitudinal`, as in
-/// the shipped crude-oil scenes: docs/validation.md, "Wall peeling".
-const SCENE_WALL_ADHESION: f64 = 4.0;
 
 /// One run of `slosh-load-convergence`: 0.3 g lateral pulse on `counts`, steps ≤ `h`,
 /// figures of F_y over [t_a, t_b] (the run ends at t_b).

@@ -39,7 +39,7 @@ use rail_mbs::vehicle::equivalent::cylinder_lambda;
 use rail_mbs::vehicle::fluid::{FluidCargo, FluidTrainRecord, run_fluid_train};
 use rail_mbs::vehicle::{BrakeScope, TankCarParams, TrainScenario};
 
-use crate::Record;
+use crate::{Record, SCENE_WALL_ADHESION, SCENE_WALL_DAMPING};
 
 pub use rail_mbs::defaults::{Oil, SETTLE, brake_torque};
 
@@ -571,8 +571,8 @@ fn coupler_force_convergence(quick: bool) -> Result<Vec<Record>> {
             counts,
             t_end,
             rear_brake_factor,
-            wall_damping_ratio: 1.0,
-            wall_adhesion: 4.0,
+            wall_damping_ratio: SCENE_WALL_DAMPING,
+            wall_adhesion: SCENE_WALL_ADHESION,
             linear_solver: rail_mbs::integrator::LinearSolverKind::Condensed,
             shear_stabilization: true,
         };

@@ -4,22 +4,17 @@
 //! largest longitudinal and lateral effective mass, for each shear stabilization given as a
 //! multiple β of ρ g H (−1: the recommended `default_shear_stabilization`).
 //!
-//! `cargo run --release -p rail-mbs --example rest_state -- KIND NV NP PPE NX NY NZ BETA...`
+//! `cargo run --release -p railslosh-cases --example rest_state -- KIND NV NP PPE NX NY NZ BETA...`
 //! with KIND `box` (seed 003 rectangular tank), `swri` (SwRI elliptic tank) or `car` (the tank
 //! car half full of light crude; `HEAD=0` for flat ends), NV/NP the viscous/penalty points per
 //! direction, PPE the contact points per face edge and NX NY NZ the element counts.
 //! `SHAPE=1` also prints the nodes that carry the three lowest modes; `ADH=a` gives the walls an
-//! adhesion of a ρ g H (`WallContactLaw::with_adhesion`).
-use ancf_core::FluidBody;
+//! adhesion of a ρ g H (`WallContactLaw::with_adhesion`). The models are those of the `rest-state`
+//! case (`railslosh_cases::slosh::RestMesh::tank`, settled by `railslosh_cases::slosh::settled`).
 use ancf_core::constants::GRAVITY as G;
-use ancf_core::constitutive::Rheology;
-use ancf_core::contact::{WallContact, WallContactLaw};
 use ancf_core::element::QuadratureOptions;
-use ancf_core::mesh::{CylinderTankSpec, EllipticCylinderSpec, box_mesh, cylinder_tank, elliptic_cylinder};
-use ancf_core::tank::{TankGeometry, TankShape};
-use rail_mbs::defaults::{Oil, liquid, slosh_params};
-use rail_mbs::slosh::{PrescribedMotion, SloshFrame, SloshRun, SloshSystem, linear_modes};
-use rail_mbs::vehicle::TankCarParams;
+use rail_mbs::slosh::linear_modes;
+use railslosh_cases::slosh::{RestMesh, settled};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -28,66 +23,22 @@ fn main() {
     let (nv, np, ppe) = (a[0] as usize, a[1] as usize, a[2] as usize);
     let c = [a[3] as usize, a[4] as usize, a[5] as usize];
     let gs = &a[6..];
-    let (mesh, geo, depth, mut fluid) = match kind.as_str() {
-        "swri" => {
-            let spec = EllipticCylinderSpec::swri(c[0], c[1], c[2]);
-            let mesh = elliptic_cylinder(&spec).unwrap();
-            let depth = mesh.liquid_depth();
-            let geo = TankGeometry::new(
-                TankShape::EllipticCylinder {
-                    length: spec.length,
-                    semi_axis_y: spec.semi_axis_y,
-                    semi_axis_z: spec.semi_axis_z,
-                },
-                vec![],
-            )
-            .unwrap();
-            let fl = liquid(998.0, Rheology::Newtonian { viscosity: 1e-3 }, depth, depth / c[2] as f64).unwrap();
-            (mesh, geo, depth, fl)
-        }
-        "box" => {
-            let l = [0.416, 0.324, 0.132];
-            let lo = [-0.5 * l[0], -0.5 * l[1], 0.0];
-            let mesh = box_mesh(lo, l, c).unwrap();
-            let geo =
-                TankGeometry::new(TankShape::Box { min: lo, max: [0.5 * l[0], 0.5 * l[1], 0.3] }, vec![]).unwrap();
-            let fl = liquid(998.0, Rheology::Newtonian { viscosity: 1e-3 }, l[2], l[2] / c[2] as f64).unwrap();
-            (mesh, geo, l[2], fl)
-        }
-        _ => {
-            let p = TankCarParams::standard().unwrap();
-            let head: f64 = std::env::var("HEAD").map(|s| s.parse().unwrap()).unwrap_or(0.5);
-            let spec = CylinderTankSpec { length: p.tank_length - 2.0 * head, head_depth: head, ..p.tank_spec(0.5, c) };
-            let mesh = cylinder_tank(&spec).unwrap();
-            let geo = TankGeometry::new(spec.shape(), vec![]).unwrap();
-            let fl = Oil::Light.fluid(p.tank_radius, p.tank_radius / c[2] as f64).unwrap();
-            (mesh, geo, p.tank_radius, fl)
-        }
+    let mesh = match kind.as_str() {
+        "swri" => RestMesh::Swri(c),
+        "box" => RestMesh::Box(c),
+        _ => RestMesh::Car(c),
     };
-    let rho = fluid.density;
-    let working = fluid.rheology;
-    fluid.rheology = Rheology::Newtonian { viscosity: 1e4 };
-    let body = FluidBody::new(mesh, fluid, QuadratureOptions { viscous: nv, penalty: np, mass: 4 }).unwrap();
+    let head: Option<f64> = std::env::var("HEAD").ok().map(|s| s.parse().unwrap());
+    let tank = mesh.tank(head).unwrap();
+    let (rho, depth) = (tank.fluid.density, tank.depth);
+    let working = tank.fluid.rheology;
+    let g_default = tank.recommended_stabilization();
     let adhesion: f64 = std::env::var("ADH").ok().map_or(0.0, |v| v.parse().unwrap());
-    let law = WallContactLaw { points_per_edge: ppe, ..WallContactLaw::default_for(rho, G, depth) }
-        .with_adhesion(adhesion, rho, G, depth)
-        .unwrap();
-    let contact = WallContact::new(&body, geo, law).unwrap();
-    let sys =
-        SloshSystem::new(body, contact, PrescribedMotion::at_rest([0.0; 3]), [0.0, 0.0, -G], SloshFrame::Inertial)
-            .unwrap();
-    let mut run = SloshRun::new(sys, 0.0, slosh_params()).unwrap();
+    let law = tank.wall_law(ppe).with_adhesion(adhesion, rho, G, depth).unwrap();
     let ts: f64 = std::env::var("TS").map(|s| s.parse().unwrap()).unwrap_or(3.0);
-    run.run_to(ts, 0.02).unwrap();
-    let q = run.stepper.q().to_vec();
-    let run_v = run.stepper.v().to_vec();
-    let mut sys = run.stepper.into_system();
+    let quadrature = QuadratureOptions { viscous: nv, penalty: np, mass: 4 };
+    let (mut sys, q, run_v) = settled(tank.mesh, tank.fluid, tank.geometry, law, quadrature, ts).unwrap();
     let rgh = rho * G * depth;
-    // the recommended value for this mesh's element height (its fluid carries none)
-    let heads = (!matches!(kind.as_str(), "swri" | "box")
-        && std::env::var("HEAD").map_or(true, |h| h.parse::<f64>().unwrap() > 0.0))
-    .then_some(depth);
-    let g_default = rail_mbs::defaults::default_shear_stabilization(rho, depth / c[2] as f64, heads);
     {
         use rail_mbs::integrator::MechanicalSystem;
         let n = sys.n_coords();
