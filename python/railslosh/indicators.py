@@ -486,210 +486,161 @@ def _time_over(t: np.ndarray, da: Any, limit: float, min_duration: float) -> np.
     return _per_channel(da, lambda x: time_over_limit(t, x, limit, min_duration))
 
 
-def add_indicators(
+def _add_derailment(
+    out: Any,
     ds: Any,
+    part: Any,
+    t: np.ndarray,
+    within: str,
     *,
-    wohler_exponent: float = 3.0,
-    n_eq: float | None = None,
-    equivalent_frequency: float = 1.0,
-    bins: int = 20,
-    friction: float = NADAL_FRICTION,
-    min_duration: float = MIN_DURATION,
-    static_load: Any = None,
-    include_settling: bool = False,
-    acceleration: str = ACCELERATION_VARIABLE,
-) -> Any:
-    """A copy of a results Dataset (:func:`railslosh.results.to_dataset`) with every indicator
-    its variables support, each with ``units``, ``long_name`` and ``standard`` attributes. Maxima,
-    durations, spectra and ride values cover the run after the settling phase
-    (:func:`railslosh.results.settling`; the whole run with ``include_settling``); the global
-    attribute ``indicators_after`` holds its start (s) and ``indicators_skipped`` says what the
-    run does not record.
-
-    * Derailment (wheel loads): ``l_over_v_max`` and ``l_over_v_time_over_limit`` per wheel against
-      Nadal's limit (:func:`nadal_limit`, the profile's flange angle, μ = ``friction``);
-      ``weinstock`` (time series), ``weinstock_max`` and ``weinstock_time_over_limit`` per axle
-      against :data:`WEINSTOCK_LIMIT`; ``unloading_max`` and ``unloading_time_over_limit`` per wheel
-      against the ``unloading_limit`` attribute or :data:`UNLOADING_LIMIT`, with Q₀ =
-      ``wheel_load_reference``: ``static_load`` (N) when given, else each wheel's load at the end
-      of the settling phase when the run has one, else the ``static_wheel_load`` attribute. Times
-      over a limit count exceedances of ``min_duration`` (50 ms) or longer (:func:`exceedances`).
-    * Roll-over: ``load_transfer_bogie`` and ``load_transfer_car`` (time series,
-      :func:`load_transfer_ratio`) and their largest ``|LTR|``, ``*_max``.
-    * Load spectra of ``coupler_force``, ``wheel_vertical``, ``fluid_force_tank`` and ``force_tank``
-      (those present): ``<name>_rainflow`` (cycle counts in ``bins`` range bins, coordinate
-      ``<name>_range`` = upper bin edge), ``<name>_del`` (:func:`damage_equivalent_load` for
-      ``wohler_exponent`` and N_eq = ``n_eq``, default ``equivalent_frequency`` × the evaluated
-      duration: the 1 Hz equivalent load), ``<name>_crossings`` (:func:`level_crossings` at
-      ``bins`` + 1 levels from the smallest to the largest value, coordinate ``<name>_level``).
-    * Ride: with a car-body acceleration ``acceleration`` (dims time, car, component; m/s²)
-      ``sperling_wz`` (car, direction) and ``iso2631_weighted_rms`` (car, component). Without it,
-      the longitudinal ``iso2631_weighted_rms`` (component x) of the acceleration got by
-      differentiating ``tank_speed`` (said in its ``derived`` attribute); no Sperling index (it has
-      no longitudinal weighting).
-    """
+    friction: float,
+    dur: float,
+    static_load: Any,
+    settle: Any,
+) -> tuple[Any, Any]:
+    """Derailment: L/V against Nadal's limit, the Weinstock sum and the wheel unloading
+    (:func:`add_indicators`); returns the Dataset and the wheel loads (time, wheelset, side)."""
     import xarray as xr
 
     from railslosh import results
 
-    m = _positive("wohler_exponent", wohler_exponent, "a Wöhler exponent")
-    feq = _positive("equivalent_frequency", equivalent_frequency, "a frequency in Hz")
-    if n_eq is not None:
-        _positive("n_eq", n_eq, "an equivalent cycle count")
-    if isinstance(bins, bool) or not isinstance(bins, int | np.integer) or bins < 1:
-        raise invalid("bins", bins, "a whole number ≥ 1")
-    dur = _positive("min_duration", min_duration, "a duration in s", zero=True)
-    if "time" not in ds.dims:
-        raise invalid("ds", "Dataset without a time dimension", "a results Dataset (railslosh.results.to_dataset)")
-    out = ds.copy()
-    settle = results.settling(ds)
-    after = 0.0 if include_settling else settle.time
-    part = results.after_settling(ds, after)
-    t = np.asarray(part["time"].values, dtype=float)
-    skipped: list[str] = []
-    out.attrs["indicators_after"] = float(after)
-    if t.size < 2:
-        out.attrs["indicators_skipped"] = f"all: fewer than 2 samples at t ≥ {after:g} s"
-        return out
-    span = float(t[-1] - t[0])
-    within = f"over {t[0]:g} ≤ t ≤ {t[-1]:g} s" + (" (after settling)" if after > 0 else "")
-
-    # derailment
-    if "wheel_vertical" in ds and "side" in ds["wheel_vertical"].dims and ds.sizes.get("wheelset", 0):
-        delta = flange_angle(ds)
-        nadal = nadal_limit(delta, friction)
-        if "l_over_v" in ds:
-            lv_all, lv = ds["l_over_v"], part["l_over_v"]
-            lv_note = "the run's l_over_v"
-        else:
-            q_lv = ds["wheel_vertical"]
-            lv_all = xr.where(q_lv > 0, abs(ds["wheel_lateral"]) / q_lv.where(q_lv > 0), 0.0)
-            lv = lv_all.sel(time=part["time"])
-            lv_note = "|wheel_lateral| / wheel_vertical (0 where the wheel is off the rail)"
-        nadal_std = f"Nadal (1908) flange-climb limit (tan δ − μ)/(1 + μ tan δ); {_AAR_DURATION}"
-        lim_attrs = {
-            "limit": nadal,
-            "flange_angle": delta,
-            "friction": float(friction),
-            "wheel_profile": wheel_profile(ds),
-        }
-        out["l_over_v_max"] = (
-            ("wheelset", "side"),
-            np.asarray(lv.max("time").values, dtype=float),
-            _attrs("1", f"largest wheel L/V = |Y|/Q {within}", nadal_std, source=lv_note, **lim_attrs),
-        )
-        out["l_over_v_time_over_limit"] = (
-            ("wheelset", "side"),
-            _time_over(t, lv, nadal, dur),
-            _attrs(
-                "s",
-                f"time the wheel L/V stays above Nadal's limit {nadal:.3f} in spells ≥ {dur * 1e3:g} ms",
-                nadal_std,
-                min_duration=dur,
-                **lim_attrs,
-            ),
-        )
-        ws = weinstock_sum(np.asarray(lv_all.transpose("time", "wheelset", "side").values, dtype=float))
-        wstd = f"Weinstock (1984) axle-sum L/V; limit {WEINSTOCK_LIMIT:g}: AAR MSRP C-II Chapter XI; {_AAR_DURATION}"
-        out["weinstock"] = (
-            ("time", "wheelset"),
-            ws,
-            _attrs(
-                "1", "axle sum of the wheel L/V ratios |Y_l|/Q_l + |Y_r|/Q_r (Weinstock)", wstd, limit=WEINSTOCK_LIMIT
-            ),
-        )
-        wpart = out["weinstock"].sel(time=part["time"])
-        out["weinstock_max"] = (
-            ("wheelset",),
-            np.asarray(wpart.max("time").values, dtype=float),
-            _attrs("1", f"largest axle-sum L/V (Weinstock) {within}", wstd, limit=WEINSTOCK_LIMIT),
-        )
-        out["weinstock_time_over_limit"] = (
-            ("wheelset",),
-            _time_over(t, wpart, WEINSTOCK_LIMIT, dur),
-            _attrs(
-                "s",
-                f"time the axle-sum L/V stays above {WEINSTOCK_LIMIT:g} in spells ≥ {dur * 1e3:g} ms",
-                wstd,
-                limit=WEINSTOCK_LIMIT,
-                min_duration=dur,
-            ),
-        )
-        q_all = ds["wheel_vertical"].transpose("time", "wheelset", "side")
-        if static_load is not None:
-            q0 = np.broadcast_to(np.asarray(static_load, dtype=float), q_all.shape[1:]).copy()
-            q0_note = "given (static_load)"
-        elif settle.time > 0:
-            q0 = np.asarray(results.after_settling(ds, settle)["wheel_vertical"].transpose("time", ...).values[0])
-            q0_note = f"each wheel's load at the end of the settling phase (t = {settle.time:g} s, {settle.source})"
-        elif "static_wheel_load" in ds.attrs:
-            q0 = np.full(q_all.shape[1:], float(ds.attrs["static_wheel_load"]))
-            q0_note = "the run's static wheel load (static_wheel_load attribute)"
-        else:
-            q0 = np.asarray(q_all.values[0], dtype=float)
-            q0_note = "each wheel's first recorded load"
-        unl_lim = float(ds.attrs.get("unloading_limit", UNLOADING_LIMIT))
-        unl = wheel_unloading(np.asarray(part["wheel_vertical"].transpose("time", "wheelset", "side").values), q0)
-        unl_da = xr.DataArray(unl, dims=("time", "wheelset", "side"))
-        ustd = f"{UNLOADING_STANDARD} (limit {unl_lim:g}); {_AAR_DURATION}"
-        out["wheel_load_reference"] = (
-            ("wheelset", "side"),
-            q0,
-            _attrs("N", "static wheel load Q0 of the unloading ΔQ/Q0", UNLOADING_STANDARD, source=q0_note),
-        )
-        out["unloading_max"] = (
-            ("wheelset", "side"),
-            np.asarray(unl_da.max("time").values),
-            _attrs("1", f"largest wheel unloading (Q0 − Q)/Q0 {within}", ustd, limit=unl_lim, reference=q0_note),
-        )
-        out["unloading_time_over_limit"] = (
-            ("wheelset", "side"),
-            _time_over(t, unl_da, unl_lim, dur),
-            _attrs(
-                "s",
-                f"time the wheel unloading stays above {unl_lim:g} in spells ≥ {dur * 1e3:g} ms",
-                ustd,
-                limit=unl_lim,
-                min_duration=dur,
-                reference=q0_note,
-            ),
-        )
-        # roll-over
-        nw, ncar = ds.sizes["wheelset"], ds.sizes.get("car", 1)
-        per = nw // ncar if ncar and nw % ncar == 0 else 0
-        if per >= 2 and per % 2 == 0:
-            q = np.asarray(q_all.values, dtype=float)
-            ltr_std = "load transfer ratio (ΣQ_right − ΣQ_left)/(ΣQ_right + ΣQ_left); |LTR| = 1: one side lifted off"
-            bogie = load_transfer_ratio(q.reshape(q.shape[0], 2 * ncar, per // 2, 2))
-            car = load_transfer_ratio(q.reshape(q.shape[0], ncar, per, 2))
-            out = out.assign_coords(
-                bogie=("bogie", np.arange(1, 2 * ncar + 1), {"long_name": "bogie, front to rear over all cars"})
-            )
-            if "car" not in out.coords:
-                out = out.assign_coords(car=("car", np.arange(1, ncar + 1), {"long_name": "car, front to rear"}))
-            keep = np.flatnonzero(np.asarray(ds["time"].values) >= after - 1e-12)
-            for name, val, dim, what in (
-                ("load_transfer_bogie", bogie, "bogie", "bogie"),
-                ("load_transfer_car", car, "car", "car"),
-            ):
-                out[name] = (
-                    ("time", dim),
-                    val,
-                    _attrs("1", f"load transfer ratio of each {what} (positive: to the right)", ltr_std, limit=1.0),
-                )
-                out[f"{name}_max"] = (
-                    (dim,),
-                    np.fmax.reduce(np.abs(val[keep]), axis=0),
-                    _attrs("1", f"largest |load transfer ratio| of each {what} {within}", ltr_std, limit=1.0),
-                )
-        else:
-            skipped.append(f"load transfer ratio: {nw} wheelsets on {ncar} car(s) do not split into two-axle bogies")
+    delta = flange_angle(ds)
+    nadal = nadal_limit(delta, friction)
+    if "l_over_v" in ds:
+        lv_all, lv = ds["l_over_v"], part["l_over_v"]
+        lv_note = "the run's l_over_v"
     else:
-        skipped.append("derailment and roll-over: no wheel loads (wheel_vertical) recorded")
+        q_lv = ds["wheel_vertical"]
+        lv_all = xr.where(q_lv > 0, abs(ds["wheel_lateral"]) / q_lv.where(q_lv > 0), 0.0)
+        lv = lv_all.sel(time=part["time"])
+        lv_note = "|wheel_lateral| / wheel_vertical (0 where the wheel is off the rail)"
+    nadal_std = f"Nadal (1908) flange-climb limit (tan δ − μ)/(1 + μ tan δ); {_AAR_DURATION}"
+    lim_attrs = {
+        "limit": nadal,
+        "flange_angle": delta,
+        "friction": float(friction),
+        "wheel_profile": wheel_profile(ds),
+    }
+    out["l_over_v_max"] = (
+        ("wheelset", "side"),
+        np.asarray(lv.max("time").values, dtype=float),
+        _attrs("1", f"largest wheel L/V = |Y|/Q {within}", nadal_std, source=lv_note, **lim_attrs),
+    )
+    out["l_over_v_time_over_limit"] = (
+        ("wheelset", "side"),
+        _time_over(t, lv, nadal, dur),
+        _attrs(
+            "s",
+            f"time the wheel L/V stays above Nadal's limit {nadal:.3f} in spells ≥ {dur * 1e3:g} ms",
+            nadal_std,
+            min_duration=dur,
+            **lim_attrs,
+        ),
+    )
+    ws = weinstock_sum(np.asarray(lv_all.transpose("time", "wheelset", "side").values, dtype=float))
+    wstd = f"Weinstock (1984) axle-sum L/V; limit {WEINSTOCK_LIMIT:g}: AAR MSRP C-II Chapter XI; {_AAR_DURATION}"
+    out["weinstock"] = (
+        ("time", "wheelset"),
+        ws,
+        _attrs("1", "axle sum of the wheel L/V ratios |Y_l|/Q_l + |Y_r|/Q_r (Weinstock)", wstd, limit=WEINSTOCK_LIMIT),
+    )
+    wpart = out["weinstock"].sel(time=part["time"])
+    out["weinstock_max"] = (
+        ("wheelset",),
+        np.asarray(wpart.max("time").values, dtype=float),
+        _attrs("1", f"largest axle-sum L/V (Weinstock) {within}", wstd, limit=WEINSTOCK_LIMIT),
+    )
+    out["weinstock_time_over_limit"] = (
+        ("wheelset",),
+        _time_over(t, wpart, WEINSTOCK_LIMIT, dur),
+        _attrs(
+            "s",
+            f"time the axle-sum L/V stays above {WEINSTOCK_LIMIT:g} in spells ≥ {dur * 1e3:g} ms",
+            wstd,
+            limit=WEINSTOCK_LIMIT,
+            min_duration=dur,
+        ),
+    )
+    q_all = ds["wheel_vertical"].transpose("time", "wheelset", "side")
+    if static_load is not None:
+        q0 = np.broadcast_to(np.asarray(static_load, dtype=float), q_all.shape[1:]).copy()
+        q0_note = "given (static_load)"
+    elif settle.time > 0:
+        q0 = np.asarray(results.after_settling(ds, settle)["wheel_vertical"].transpose("time", ...).values[0])
+        q0_note = f"each wheel's load at the end of the settling phase (t = {settle.time:g} s, {settle.source})"
+    elif "static_wheel_load" in ds.attrs:
+        q0 = np.full(q_all.shape[1:], float(ds.attrs["static_wheel_load"]))
+        q0_note = "the run's static wheel load (static_wheel_load attribute)"
+    else:
+        q0 = np.asarray(q_all.values[0], dtype=float)
+        q0_note = "each wheel's first recorded load"
+    unl_lim = float(ds.attrs.get("unloading_limit", UNLOADING_LIMIT))
+    unl = wheel_unloading(np.asarray(part["wheel_vertical"].transpose("time", "wheelset", "side").values), q0)
+    unl_da = xr.DataArray(unl, dims=("time", "wheelset", "side"))
+    ustd = f"{UNLOADING_STANDARD} (limit {unl_lim:g}); {_AAR_DURATION}"
+    out["wheel_load_reference"] = (
+        ("wheelset", "side"),
+        q0,
+        _attrs("N", "static wheel load Q0 of the unloading ΔQ/Q0", UNLOADING_STANDARD, source=q0_note),
+    )
+    out["unloading_max"] = (
+        ("wheelset", "side"),
+        np.asarray(unl_da.max("time").values),
+        _attrs("1", f"largest wheel unloading (Q0 − Q)/Q0 {within}", ustd, limit=unl_lim, reference=q0_note),
+    )
+    out["unloading_time_over_limit"] = (
+        ("wheelset", "side"),
+        _time_over(t, unl_da, unl_lim, dur),
+        _attrs(
+            "s",
+            f"time the wheel unloading stays above {unl_lim:g} in spells ≥ {dur * 1e3:g} ms",
+            ustd,
+            limit=unl_lim,
+            min_duration=dur,
+            reference=q0_note,
+        ),
+    )
+    return out, q_all
 
-    # load spectra
-    neq = float(n_eq) if n_eq is not None else feq * span
-    neq_note = f"N_eq = {neq:g}" + ("" if n_eq is not None else f" ({feq:g} Hz × {span:g} s evaluated)")
+
+def _add_load_transfer(out: Any, ds: Any, q_all: Any, after: float, within: str, skipped: list[str]) -> Any:
+    """Roll-over: the load transfer ratio of each bogie and car (:func:`add_indicators`)."""
+    nw, ncar = ds.sizes["wheelset"], ds.sizes.get("car", 1)
+    per = nw // ncar if ncar and nw % ncar == 0 else 0
+    if per >= 2 and per % 2 == 0:
+        q = np.asarray(q_all.values, dtype=float)
+        ltr_std = "load transfer ratio (ΣQ_right − ΣQ_left)/(ΣQ_right + ΣQ_left); |LTR| = 1: one side lifted off"
+        bogie = load_transfer_ratio(q.reshape(q.shape[0], 2 * ncar, per // 2, 2))
+        car = load_transfer_ratio(q.reshape(q.shape[0], ncar, per, 2))
+        out = out.assign_coords(
+            bogie=("bogie", np.arange(1, 2 * ncar + 1), {"long_name": "bogie, front to rear over all cars"})
+        )
+        if "car" not in out.coords:
+            out = out.assign_coords(car=("car", np.arange(1, ncar + 1), {"long_name": "car, front to rear"}))
+        keep = np.flatnonzero(np.asarray(ds["time"].values) >= after - 1e-12)
+        for name, val, dim, what in (
+            ("load_transfer_bogie", bogie, "bogie", "bogie"),
+            ("load_transfer_car", car, "car", "car"),
+        ):
+            out[name] = (
+                ("time", dim),
+                val,
+                _attrs("1", f"load transfer ratio of each {what} (positive: to the right)", ltr_std, limit=1.0),
+            )
+            out[f"{name}_max"] = (
+                (dim,),
+                np.fmax.reduce(np.abs(val[keep]), axis=0),
+                _attrs("1", f"largest |load transfer ratio| of each {what} {within}", ltr_std, limit=1.0),
+            )
+    else:
+        skipped.append(f"load transfer ratio: {nw} wheelsets on {ncar} car(s) do not split into two-axle bogies")
+    return out
+
+
+def _add_load_spectra(
+    out: Any, ds: Any, part: Any, within: str, *, m: float, neq: float, neq_note: str, bins: int
+) -> Any:
+    """Load spectra: rainflow counts, damage-equivalent loads and level crossings (:func:`add_indicators`)."""
     for name in _SPECTRA:
         if name not in part or not part[name].size or "time" not in part[name].dims:
             continue
@@ -753,10 +704,12 @@ def add_indicators(
                 "ASTM E1049-85 §5.1.1 level-crossing counting",
             ),
         )
-    if not any(n in part for n in _SPECTRA):
-        skipped.append("load spectra: no coupler, wheel or liquid loads recorded")
 
-    # ride
+    return out
+
+
+def _add_ride(out: Any, ds: Any, part: Any, t: np.ndarray, within: str, acceleration: str, skipped: list[str]) -> Any:
+    """Ride: Sperling Wz and the ISO 2631 weighted RMS acceleration (:func:`add_indicators`)."""
     has_acc = acceleration in ds and {"time", "car", "component"} <= set(ds[acceleration].dims)
     if has_acc and (t.size < 8 or not np.isfinite(part[acceleration].values).all()):
         skipped.append(f"ride: fewer than 8 samples, or non-finite values, of {acceleration}")
@@ -809,6 +762,94 @@ def add_indicators(
         skipped.append("Sperling ride index and ISO 2631 y/z: no car-body acceleration recorded")
     else:
         skipped.append("ride: no car-body acceleration or tank speed recorded")
+    return out
+
+
+def add_indicators(
+    ds: Any,
+    *,
+    wohler_exponent: float = 3.0,
+    n_eq: float | None = None,
+    equivalent_frequency: float = 1.0,
+    bins: int = 20,
+    friction: float = NADAL_FRICTION,
+    min_duration: float = MIN_DURATION,
+    static_load: Any = None,
+    include_settling: bool = False,
+    acceleration: str = ACCELERATION_VARIABLE,
+) -> Any:
+    """A copy of a results Dataset (:func:`railslosh.results.to_dataset`) with every indicator
+    its variables support, each with ``units``, ``long_name`` and ``standard`` attributes. Maxima,
+    durations, spectra and ride values cover the run after the settling phase
+    (:func:`railslosh.results.settling`; the whole run with ``include_settling``); the global
+    attribute ``indicators_after`` holds its start (s) and ``indicators_skipped`` says what the
+    run does not record.
+
+    * Derailment (wheel loads): ``l_over_v_max`` and ``l_over_v_time_over_limit`` per wheel against
+      Nadal's limit (:func:`nadal_limit`, the profile's flange angle, μ = ``friction``);
+      ``weinstock`` (time series), ``weinstock_max`` and ``weinstock_time_over_limit`` per axle
+      against :data:`WEINSTOCK_LIMIT`; ``unloading_max`` and ``unloading_time_over_limit`` per wheel
+      against the ``unloading_limit`` attribute or :data:`UNLOADING_LIMIT`, with Q₀ =
+      ``wheel_load_reference``: ``static_load`` (N) when given, else each wheel's load at the end
+      of the settling phase when the run has one, else the ``static_wheel_load`` attribute. Times
+      over a limit count exceedances of ``min_duration`` (50 ms) or longer (:func:`exceedances`).
+    * Roll-over: ``load_transfer_bogie`` and ``load_transfer_car`` (time series,
+      :func:`load_transfer_ratio`) and their largest ``|LTR|``, ``*_max``.
+    * Load spectra of ``coupler_force``, ``wheel_vertical``, ``fluid_force_tank`` and ``force_tank``
+      (those present): ``<name>_rainflow`` (cycle counts in ``bins`` range bins, coordinate
+      ``<name>_range`` = upper bin edge), ``<name>_del`` (:func:`damage_equivalent_load` for
+      ``wohler_exponent`` and N_eq = ``n_eq``, default ``equivalent_frequency`` × the evaluated
+      duration: the 1 Hz equivalent load), ``<name>_crossings`` (:func:`level_crossings` at
+      ``bins`` + 1 levels from the smallest to the largest value, coordinate ``<name>_level``).
+    * Ride: with a car-body acceleration ``acceleration`` (dims time, car, component; m/s²)
+      ``sperling_wz`` (car, direction) and ``iso2631_weighted_rms`` (car, component). Without it,
+      the longitudinal ``iso2631_weighted_rms`` (component x) of the acceleration got by
+      differentiating ``tank_speed`` (said in its ``derived`` attribute); no Sperling index (it has
+      no longitudinal weighting).
+    """
+
+    from railslosh import results
+
+    m = _positive("wohler_exponent", wohler_exponent, "a Wöhler exponent")
+    feq = _positive("equivalent_frequency", equivalent_frequency, "a frequency in Hz")
+    if n_eq is not None:
+        _positive("n_eq", n_eq, "an equivalent cycle count")
+    if isinstance(bins, bool) or not isinstance(bins, int | np.integer) or bins < 1:
+        raise invalid("bins", bins, "a whole number ≥ 1")
+    dur = _positive("min_duration", min_duration, "a duration in s", zero=True)
+    if "time" not in ds.dims:
+        raise invalid("ds", "Dataset without a time dimension", "a results Dataset (railslosh.results.to_dataset)")
+    out = ds.copy()
+    settle = results.settling(ds)
+    after = 0.0 if include_settling else settle.time
+    part = results.after_settling(ds, after)
+    t = np.asarray(part["time"].values, dtype=float)
+    skipped: list[str] = []
+    out.attrs["indicators_after"] = float(after)
+    if t.size < 2:
+        out.attrs["indicators_skipped"] = f"all: fewer than 2 samples at t ≥ {after:g} s"
+        return out
+    span = float(t[-1] - t[0])
+    within = f"over {t[0]:g} ≤ t ≤ {t[-1]:g} s" + (" (after settling)" if after > 0 else "")
+
+    # derailment and roll-over
+    if "wheel_vertical" in ds and "side" in ds["wheel_vertical"].dims and ds.sizes.get("wheelset", 0):
+        out, q_all = _add_derailment(
+            out, ds, part, t, within, friction=friction, dur=dur, static_load=static_load, settle=settle
+        )
+        out = _add_load_transfer(out, ds, q_all, after, within, skipped)
+    else:
+        skipped.append("derailment and roll-over: no wheel loads (wheel_vertical) recorded")
+
+    # load spectra
+    neq = float(n_eq) if n_eq is not None else feq * span
+    neq_note = f"N_eq = {neq:g}" + ("" if n_eq is not None else f" ({feq:g} Hz × {span:g} s evaluated)")
+    out = _add_load_spectra(out, ds, part, within, m=m, neq=neq, neq_note=neq_note, bins=bins)
+    if not any(n in part for n in _SPECTRA):
+        skipped.append("load spectra: no coupler, wheel or liquid loads recorded")
+
+    # ride
+    out = _add_ride(out, ds, part, t, within, acceleration, skipped)
     if skipped:
         out.attrs["indicators_skipped"] = "; ".join(skipped)
     return out
