@@ -158,6 +158,77 @@ class Accelerator:
         del self.old[self.reuse :]
 
 
+def _checked_options(
+    scheme: str,
+    window: float,
+    substeps: int,
+    rtol: float,
+    atol: float,
+    max_iterations: int,
+    relaxation: float,
+    reuse: int,
+    filter_eps: float,
+    blowup: float,
+) -> tuple[float, float, float, float, float, float]:
+    """:func:`couple`'s options checked: (window, rtol, atol, relaxation, filter_eps, blowup)."""
+    if scheme not in SCHEMES:
+        raise invalid("scheme", scheme, f"one of {list(SCHEMES)}")
+    window = check_positive("window", window)
+    rtol = check_positive("rtol", rtol, allow_zero=True)
+    atol = check_positive("atol", atol, allow_zero=True)
+    relaxation = check_positive("relaxation", relaxation)
+    filter_eps = check_positive("filter_eps", filter_eps, allow_zero=True)
+    blowup = check_positive("blowup", blowup)
+    if not isinstance(substeps, int | np.integer) or substeps < 1:
+        raise invalid("substeps", substeps, "an integer >= 1")
+    if not isinstance(max_iterations, int | np.integer) or max_iterations < 1:
+        raise invalid("max_iterations", max_iterations, "an integer >= 1")
+    if not isinstance(reuse, int | np.integer) or reuse < 0:
+        raise invalid("reuse", reuse, "an integer >= 0")
+    if rtol == 0 and atol == 0:
+        raise invalid("rtol, atol", (rtol, atol), "at least one > 0")
+    return window, rtol, atol, relaxation, filter_eps, blowup
+
+
+def _windows(vehicle: VehicleParticipant, slosh: SloshParticipant, t_end: float, window: float) -> tuple[float, int]:
+    """The common start time of the participants and the number of windows to ``t_end``."""
+    t0 = float(vehicle.time)
+    if abs(float(slosh.time) - t0) > 1e-12:
+        raise invalid("slosh.time", slosh.time, f"equal to vehicle.time = {t0}")
+    t_end = float(t_end)
+    if not math.isfinite(t_end) or t_end <= t0:
+        raise invalid("t_end", t_end, f"a finite time > start time {t0}")
+    n_win = max(1, int(round((t_end - t0) / window)))
+    if abs(n_win * window - (t_end - t0)) > 1e-9 * max(1.0, t_end - t0):
+        raise invalid("window", window, f"a divisor of t_end - t0 = {t_end - t0}")
+    return t0, n_win
+
+
+def _consistent_start(
+    vehicle: VehicleParticipant, slosh: SloshParticipant, t0: float, ma: np.ndarray | None, filter_eps: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Consistent start: the zero-length window at ``t0`` solved by IQN-ILS; (fluid load L,
+    vehicle motion m) at ``t0``."""
+    init = Accelerator("iqn-ils", 0.5, 0, filter_eps)
+    init.start()
+    sv, ss = vehicle.save_state(), slosh.save_state()
+    x = np.zeros(6)
+    for _ in range(50):
+        vehicle.restore_state(sv)
+        slosh.restore_state(ss)
+        m = motion_to_vector(vehicle.advance(t0, x, x))
+        if hasattr(slosh, "set_initial_input"):  # participants that reject zero-length advances (the Rust one)
+            f, mo = slosh.set_initial_input(vector_to_motion(m))
+        else:
+            f, mo = slosh.advance(t0, vector_to_motion(m), vector_to_motion(m))
+        L = np.concatenate([np.asarray(f, float), np.asarray(mo, float)])
+        xt = L if ma is None else L + ma @ motion_acceleration6(vector_to_motion(m))
+        if np.linalg.norm(xt - x) <= 1e-12 * max(1.0, np.linalg.norm(xt)):
+            break
+        x = init.update(x, xt)
+    return L, m
+
+
 def couple(
     vehicle: VehicleParticipant,
     slosh: SloshParticipant,
@@ -182,31 +253,10 @@ def couple(
     ``blowup``: the run stops as diverged when a load exceeds ``blowup`` times the largest load of
     the first window (or is not finite). ``extrapolation_order``: 2 = seed 003's three samples;
     0 and 1 use fewer samples (used for the stability analysis)."""
-    if scheme not in SCHEMES:
-        raise invalid("scheme", scheme, f"one of {list(SCHEMES)}")
-    window = check_positive("window", window)
-    rtol = check_positive("rtol", rtol, allow_zero=True)
-    atol = check_positive("atol", atol, allow_zero=True)
-    relaxation = check_positive("relaxation", relaxation)
-    filter_eps = check_positive("filter_eps", filter_eps, allow_zero=True)
-    blowup = check_positive("blowup", blowup)
-    if not isinstance(substeps, int | np.integer) or substeps < 1:
-        raise invalid("substeps", substeps, "an integer >= 1")
-    if not isinstance(max_iterations, int | np.integer) or max_iterations < 1:
-        raise invalid("max_iterations", max_iterations, "an integer >= 1")
-    if not isinstance(reuse, int | np.integer) or reuse < 0:
-        raise invalid("reuse", reuse, "an integer >= 0")
-    if rtol == 0 and atol == 0:
-        raise invalid("rtol, atol", (rtol, atol), "at least one > 0")
-    t0 = float(vehicle.time)
-    if abs(float(slosh.time) - t0) > 1e-12:
-        raise invalid("slosh.time", slosh.time, f"equal to vehicle.time = {t0}")
-    t_end = float(t_end)
-    if not math.isfinite(t_end) or t_end <= t0:
-        raise invalid("t_end", t_end, f"a finite time > start time {t0}")
-    n_win = max(1, int(round((t_end - t0) / window)))
-    if abs(n_win * window - (t_end - t0)) > 1e-9 * max(1.0, t_end - t0):
-        raise invalid("window", window, f"a divisor of t_end - t0 = {t_end - t0}")
+    window, rtol, atol, relaxation, filter_eps, blowup = _checked_options(
+        scheme, window, substeps, rtol, atol, max_iterations, relaxation, reuse, filter_eps, blowup
+    )
+    t0, n_win = _windows(vehicle, slosh, t_end, window)
 
     acc = Accelerator(scheme if scheme != "explicit" else "iqn-ils", relaxation, reuse, filter_eps)
 
@@ -243,23 +293,7 @@ def couple(
     ma = current_ma()
     if added_mass:
         vehicle.set_added_mass(ma)
-    init = Accelerator("iqn-ils", 0.5, 0, filter_eps)
-    init.start()
-    sv, ss = vehicle.save_state(), slosh.save_state()
-    x = np.zeros(6)
-    for _ in range(50):
-        vehicle.restore_state(sv)
-        slosh.restore_state(ss)
-        m = motion_to_vector(vehicle.advance(t0, x, x))
-        if hasattr(slosh, "set_initial_input"):  # participants that reject zero-length advances (the Rust one)
-            f, mo = slosh.set_initial_input(vector_to_motion(m))
-        else:
-            f, mo = slosh.advance(t0, vector_to_motion(m), vector_to_motion(m))
-        L = np.concatenate([np.asarray(f, float), np.asarray(mo, float)])
-        xt = L if ma is None else L + ma @ motion_acceleration6(vector_to_motion(m))
-        if np.linalg.norm(xt - x) <= 1e-12 * max(1.0, np.linalg.norm(xt)):
-            break
-        x = init.update(x, xt)
+    L, m = _consistent_start(vehicle, slosh, t0, ma, filter_eps)
     load_hist = ThreeSampleHistory(extrapolation_order)  # fluid loads L at window ends
     acc_hist = ThreeSampleHistory(extrapolation_order)  # [a, α] at window ends
     motion_hist = ThreeSampleHistory(2)
