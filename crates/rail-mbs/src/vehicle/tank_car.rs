@@ -539,78 +539,25 @@ pub fn add_tank_car(
     let per_axlebox = 0.25 * (per_bogie + (p.bolster.mass + p.frame.mass) * g);
     let per_bearing = 0.5 * p.equalizer.mass * g;
     let wheel_load = 0.5 * (2.0 * per_axlebox + 2.0 * per_bearing + p.wheelset.mass * g);
+    let car = CarFrame {
+        name,
+        p,
+        track,
+        place: &place,
+        station,
+        half,
+        sill_z,
+        tank,
+        r0,
+        per_bogie,
+        per_axlebox,
+        per_bearing,
+        wheel_load,
+        speed,
+    };
     for (b, sign) in [(0usize, 1.0), (1, -1.0)] {
-        let sb = station + sign * half;
-        let frame_sb = track.frame(sb);
-        let axes = frame_sb.rotation;
-        let bn = format!("{name}/bogie{}", b + 1);
-        let sill = mb.add_body(place.body(format!("{name}/stub_sill{}", b + 1), p.stub_sill, sb, 0.0, sill_z))?;
-        mb.add_joint(
-            &format!("{name}/stub_sill{}-tank", b + 1),
-            JointKind::Fixed,
-            Some(sill),
-            Some(tank),
-            frame_sb.to_global(&Vector3::new(0.0, 0.0, sill_z)),
-            axes,
-        )?;
-        let bolster = mb.add_body(place.body(format!("{bn}/bolster"), p.bolster, sb, 0.0, 0.6))?;
-        let frame = mb.add_body(place.body(format!("{bn}/frame"), p.frame, sb, 0.0, 0.45))?;
-        mb.add_joint(
-            &format!("{bn}/pin"),
-            JointKind::Revolute,
-            Some(bolster),
-            Some(frame),
-            frame_sb.to_global(&Vector3::new(0.0, 0.0, 0.55)),
-            axes,
-        )?;
-        for (k, side) in [(0usize, 1.0), (1, -1.0)] {
-            let at = frame_sb.to_global(&Vector3::new(0.0, side * p.secondary_half_span, 0.75));
-            let preload = Vector3::new(0.0, 0.0, 0.5 * per_bogie);
-            let bu = bushing(mb, format!("{bn}/secondary{k}"), bolster, sill, at, axes, &p.secondary, preload);
-            mb.add_force(Box::new(bu))?;
-        }
-        let mut eq = [tank; 2];
-        for (k, side) in [(0usize, 1.0), (1, -1.0)] {
-            eq[k] = mb.add_body(place.body(
-                format!("{bn}/equalizer{}", if k == 0 { "L" } else { "R" }),
-                p.equalizer,
-                sb,
-                side * p.journal_half_span,
-                r0,
-            ))?;
-        }
-        for (w, wsign) in [(0usize, 1.0), (1, -1.0)] {
-            let sw = sb + wsign * 0.5 * p.wheelbase;
-            let fw = track.frame(sw);
-            let mut pair = [contact_pair(p, track, Side::Left)?, contact_pair(p, track, Side::Right)?];
-            let z = wheelset_height(&mut pair, &fw, r0, wheel_load);
-            let mut ws = place.body(format!("{bn}/wheelset{}", w + 1), p.wheelset, sw, 0.0, z);
-            ws.angular_velocity += fw.lateral() * (speed / r0);
-            let ws = mb.add_body(ws)?;
-            let idx = 2 * b + w;
-            wheelsets[idx] = ws;
-            for (k, side) in [(0usize, 1.0), (1, -1.0)] {
-                let at = fw.to_global(&Vector3::new(0.0, side * p.journal_half_span, z));
-                let pre = Vector3::new(0.0, 0.0, -per_axlebox);
-                let bu = bushing(mb, format!("{bn}/primary{}{k}", w + 1), frame, ws, at, fw.rotation, &p.primary, pre);
-                mb.add_force(Box::new(bu))?;
-                let pre = Vector3::new(0.0, 0.0, -per_bearing);
-                let mut jb =
-                    bushing(mb, format!("{bn}/journal{}{k}", w + 1), eq[k], ws, at, fw.rotation, &p.journal, pre);
-                jb.rotational_stiffness = [p.journal_tilt_stiffness, 0.0, p.journal_tilt_stiffness];
-                jb.free_axis = Some(1);
-                mb.add_force(Box::new(jb))?;
-            }
-            contacts[idx] = mb.add_wheelset_contact(WheelsetContact {
-                name: format!("{bn}/wheelset{}", w + 1),
-                body: ws,
-                wheels: pair,
-            })?;
-        }
-        stub_sills[b] = sill;
-        bolsters[b] = bolster;
-        frames[b] = frame;
-        equalizers[b] = eq;
+        (stub_sills[b], bolsters[b], frames[b], equalizers[b]) =
+            add_bogie(mb, &car, b, sign, &mut wheelsets, &mut contacts)?;
     }
     let trajectory = match drive {
         Some(profile) => {
@@ -655,6 +602,122 @@ pub fn add_tank_car(
         static_wheel_load: wheel_load,
         station,
     })
+}
+
+/// What [`add_tank_car`] has fixed before it builds its bogies ([`add_bogie`]).
+#[derive(Clone, Copy)]
+struct CarFrame<'a> {
+    name: &'a str,
+    p: &'a TankCarParams,
+    track: &'a Arc<Track>,
+    place: &'a Placer<'a>,
+    station: f64,
+    half: f64,
+    sill_z: f64,
+    tank: BodyId,
+    r0: f64,
+    per_bogie: f64,
+    per_axlebox: f64,
+    per_bearing: f64,
+    wheel_load: f64,
+    speed: f64,
+}
+
+/// Bogie `b` (0 front, `sign` +1; 1 rear, −1) of [`add_tank_car`]: its stub sill fixed to the
+/// tank, bolster, frame, equalizers and two wheelsets with their suspensions and wheel/rail
+/// contacts (written into `wheelsets` and `contacts` at 2b + w). Returns (stub sill, bolster,
+/// frame, equalizers).
+fn add_bogie(
+    mb: &mut Multibody,
+    car: &CarFrame,
+    b: usize,
+    sign: f64,
+    wheelsets: &mut [BodyId; 4],
+    contacts: &mut [usize; 4],
+) -> Result<(BodyId, BodyId, BodyId, [BodyId; 2]), AncfError> {
+    let CarFrame {
+        name,
+        p,
+        track,
+        place,
+        station,
+        half,
+        sill_z,
+        tank,
+        r0,
+        per_bogie,
+        per_axlebox,
+        per_bearing,
+        wheel_load,
+        speed,
+    } = *car;
+    let sb = station + sign * half;
+    let frame_sb = track.frame(sb);
+    let axes = frame_sb.rotation;
+    let bn = format!("{name}/bogie{}", b + 1);
+    let sill = mb.add_body(place.body(format!("{name}/stub_sill{}", b + 1), p.stub_sill, sb, 0.0, sill_z))?;
+    mb.add_joint(
+        &format!("{name}/stub_sill{}-tank", b + 1),
+        JointKind::Fixed,
+        Some(sill),
+        Some(tank),
+        frame_sb.to_global(&Vector3::new(0.0, 0.0, sill_z)),
+        axes,
+    )?;
+    let bolster = mb.add_body(place.body(format!("{bn}/bolster"), p.bolster, sb, 0.0, 0.6))?;
+    let frame = mb.add_body(place.body(format!("{bn}/frame"), p.frame, sb, 0.0, 0.45))?;
+    mb.add_joint(
+        &format!("{bn}/pin"),
+        JointKind::Revolute,
+        Some(bolster),
+        Some(frame),
+        frame_sb.to_global(&Vector3::new(0.0, 0.0, 0.55)),
+        axes,
+    )?;
+    for (k, side) in [(0usize, 1.0), (1, -1.0)] {
+        let at = frame_sb.to_global(&Vector3::new(0.0, side * p.secondary_half_span, 0.75));
+        let preload = Vector3::new(0.0, 0.0, 0.5 * per_bogie);
+        let bu = bushing(mb, format!("{bn}/secondary{k}"), bolster, sill, at, axes, &p.secondary, preload);
+        mb.add_force(Box::new(bu))?;
+    }
+    let mut eq = [tank; 2];
+    for (k, side) in [(0usize, 1.0), (1, -1.0)] {
+        eq[k] = mb.add_body(place.body(
+            format!("{bn}/equalizer{}", if k == 0 { "L" } else { "R" }),
+            p.equalizer,
+            sb,
+            side * p.journal_half_span,
+            r0,
+        ))?;
+    }
+    for (w, wsign) in [(0usize, 1.0), (1, -1.0)] {
+        let sw = sb + wsign * 0.5 * p.wheelbase;
+        let fw = track.frame(sw);
+        let mut pair = [contact_pair(p, track, Side::Left)?, contact_pair(p, track, Side::Right)?];
+        let z = wheelset_height(&mut pair, &fw, r0, wheel_load);
+        let mut ws = place.body(format!("{bn}/wheelset{}", w + 1), p.wheelset, sw, 0.0, z);
+        ws.angular_velocity += fw.lateral() * (speed / r0);
+        let ws = mb.add_body(ws)?;
+        let idx = 2 * b + w;
+        wheelsets[idx] = ws;
+        for (k, side) in [(0usize, 1.0), (1, -1.0)] {
+            let at = fw.to_global(&Vector3::new(0.0, side * p.journal_half_span, z));
+            let pre = Vector3::new(0.0, 0.0, -per_axlebox);
+            let bu = bushing(mb, format!("{bn}/primary{}{k}", w + 1), frame, ws, at, fw.rotation, &p.primary, pre);
+            mb.add_force(Box::new(bu))?;
+            let pre = Vector3::new(0.0, 0.0, -per_bearing);
+            let mut jb = bushing(mb, format!("{bn}/journal{}{k}", w + 1), eq[k], ws, at, fw.rotation, &p.journal, pre);
+            jb.rotational_stiffness = [p.journal_tilt_stiffness, 0.0, p.journal_tilt_stiffness];
+            jb.free_axis = Some(1);
+            mb.add_force(Box::new(jb))?;
+        }
+        contacts[idx] = mb.add_wheelset_contact(WheelsetContact {
+            name: format!("{bn}/wheelset{}", w + 1),
+            body: ws,
+            wheels: pair,
+        })?;
+    }
+    Ok((sill, bolster, frame, eq))
 }
 
 /// Joins the rear of `front` to the front of `rear` with a coupler (linear
