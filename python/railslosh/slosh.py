@@ -4,7 +4,9 @@
     >>> mesh = rs.mesh.box((0.416, 0.324, 0.132), (3, 6, 2))
     >>> tank = rs.slosh.TankGeometry.box((-0.208, -0.162, 0.0), (0.208, 0.162, 0.3))
     >>> motion = rs.slosh.Motion().pulse("y", 0.3 * rs.constants.GRAVITY, 0.0, 0.5)
-    >>> res = rs.slosh.run(mesh, rs.fluids.water(depth=0.132), tank, motion, t_end=2.0, h=0.004)
+    >>> res = rs.slosh.run(mesh, rs.fluids.water(depth=0.132), tank, motion, t_end=2.0, h=0.004,
+    ...                    viscous_points=4, penalty_points=4, contact_points_per_edge=4,
+    ...                    wall_damping_ratio=1.0, wall_adhesion=4.0)  # clean loads (README)
     >>> res["force_tank"].shape  # (steps + 1, 3): load of the fluid on the tank, tank axes
 
 Loads are the force and moment the fluid exerts on the tank (through wall and bulkhead
