@@ -75,3 +75,8 @@ def test_the_liquids_and_penalty_rules_are_the_rust_defaults():
     assert fluids.default_bulk_damping(2.0e6, 850.0, 0.5) == pytest.approx(0.2 * np.sqrt(2.0e6 * 850.0) * 0.5)
     with pytest.raises(ValueError, match="element_height"):
         _core.default_bulk_damping(2.0e6, 850.0, -1.0)
+    # the preset liquids take the recommended shear stabilization like the laws they wrap
+    gs = fluids.default_shear_stabilization(998.0, 0.066)
+    assert fluids.water(depth=0.132, shear_stabilization=gs).shear_stabilization == gs > 0.0
+    assert fluids.crude_oil("heavy", shear_stabilization=12.5).shear_stabilization == 12.5
+    assert fluids.water().shear_stabilization == fluids.crude_oil("light").shear_stabilization == 0.0

@@ -175,15 +175,21 @@ def casson(
     )
 
 
-def crude_oil(kind: str, *, depth: float = 1.5, bulk_penalty: float | None = None) -> Fluid:
-    """Light, medium or heavy crude of seed 000 Table 2, with the Oldroyd model as in the paper."""
+def crude_oil(
+    kind: str, *, depth: float = 1.5, bulk_penalty: float | None = None, shear_stabilization: float = 0.0
+) -> Fluid:
+    """Light, medium or heavy crude of seed 000 Table 2, with the Oldroyd model as in the paper.
+    ``shear_stabilization`` (Pa, default 0) as in :func:`oldroyd`; :func:`default_shear_stabilization`
+    gives the recommended value."""
     if kind not in CRUDE_OILS:
         raise ValueError(f"invalid `kind` = {kind!r}: expected one of {sorted(CRUDE_OILS)}")
     rho, mu, tau0 = CRUDE_OILS[kind]
-    return oldroyd(rho, mu, tau0, depth=depth, bulk_penalty=bulk_penalty)
+    return oldroyd(rho, mu, tau0, depth=depth, bulk_penalty=bulk_penalty, shear_stabilization=shear_stabilization)
 
 
-def water(*, depth: float = 1.5, bulk_penalty: float | None = None) -> Fluid:
-    """Water at 20 C: 998 kg/m^3, 1.0e-3 Pa s (``LIQUIDS["water"]``)."""
+def water(*, depth: float = 1.5, bulk_penalty: float | None = None, shear_stabilization: float = 0.0) -> Fluid:
+    """Water at 20 C: 998 kg/m^3, 1.0e-3 Pa s (``LIQUIDS["water"]``). ``shear_stabilization`` (Pa,
+    default 0) as in :func:`newtonian`; :func:`default_shear_stabilization` gives the recommended
+    value."""
     rho, mu, _ = LIQUIDS["water"]
-    return newtonian(rho, mu, depth=depth, bulk_penalty=bulk_penalty)
+    return newtonian(rho, mu, depth=depth, bulk_penalty=bulk_penalty, shear_stabilization=shear_stabilization)
