@@ -544,8 +544,6 @@ pub fn add_tank_car(
         p,
         track,
         place: &place,
-        station,
-        half,
         sill_z,
         tank,
         r0,
@@ -557,7 +555,7 @@ pub fn add_tank_car(
     };
     for (b, sign) in [(0usize, 1.0), (1, -1.0)] {
         (stub_sills[b], bolsters[b], frames[b], equalizers[b]) =
-            add_bogie(mb, &car, b, sign, &mut wheelsets, &mut contacts)?;
+            add_bogie(mb, &car, b, station + sign * half, &mut wheelsets, &mut contacts)?;
     }
     let trajectory = match drive {
         Some(profile) => {
@@ -611,8 +609,6 @@ struct CarFrame<'a> {
     p: &'a TankCarParams,
     track: &'a Arc<Track>,
     place: &'a Placer<'a>,
-    station: f64,
-    half: f64,
     sill_z: f64,
     tank: BodyId,
     r0: f64,
@@ -623,35 +619,20 @@ struct CarFrame<'a> {
     speed: f64,
 }
 
-/// Bogie `b` (0 front, `sign` +1; 1 rear, −1) of [`add_tank_car`]: its stub sill fixed to the
-/// tank, bolster, frame, equalizers and two wheelsets with their suspensions and wheel/rail
-/// contacts (written into `wheelsets` and `contacts` at 2b + w). Returns (stub sill, bolster,
-/// frame, equalizers).
+/// Bogie `b` (0 front, 1 rear) of [`add_tank_car`], centred at track station `sb`: its stub sill
+/// fixed to the tank, bolster, frame, equalizers and two wheelsets with their suspensions and
+/// wheel/rail contacts (written into `wheelsets` and `contacts` at 2b + w). Returns (stub sill,
+/// bolster, frame, equalizers).
 fn add_bogie(
     mb: &mut Multibody,
     car: &CarFrame,
     b: usize,
-    sign: f64,
+    sb: f64,
     wheelsets: &mut [BodyId; 4],
     contacts: &mut [usize; 4],
 ) -> Result<(BodyId, BodyId, BodyId, [BodyId; 2]), AncfError> {
-    let CarFrame {
-        name,
-        p,
-        track,
-        place,
-        station,
-        half,
-        sill_z,
-        tank,
-        r0,
-        per_bogie,
-        per_axlebox,
-        per_bearing,
-        wheel_load,
-        speed,
-    } = *car;
-    let sb = station + sign * half;
+    let CarFrame { name, p, track, place, sill_z, tank, r0, per_bogie, per_axlebox, per_bearing, wheel_load, speed } =
+        *car;
     let frame_sb = track.frame(sb);
     let axes = frame_sb.rotation;
     let bn = format!("{name}/bogie{}", b + 1);
