@@ -92,12 +92,12 @@ fn the_right_wheel_is_the_mirror_image_of_the_left_wheel_over_a_sweep_of_shifts(
 }
 
 #[test]
-#[ignore = "issue 21 open: at y = -7.1 mm (flange root) the warm-started search finds a near-conformal \
-            Newton point (N = 163 kN, relative curvature 0.035 1/m) that a fresh search misses (scan \
-            fall-back 1.9 mm away, N = 54.5 kN); docs/validation.md, Wheel/rail contact"]
 fn the_contact_of_a_pose_does_not_depend_on_the_search_history() {
     // The search starts Newton from earlier solutions when they lie near a scan seed; the
     // points it returns must still be those of a fresh search (same method, same point).
+    // Before cdf81e2 (the scan's gap along the rail normal) a fresh search at y = -7.1 mm
+    // (flange root) missed the near-conformal Newton point the warm search found (Newton against
+    // ScanFallback; docs/validation.md, "Mirror symmetry and the search history").
     let mut warm = contact(Side::Right);
     let mut fresh = contact(Side::Right);
     let (v, r0) = (20.0, 0.46);
