@@ -319,3 +319,133 @@ fn condensed_and_direct_solves_give_the_same_train_run() {
     let (q2, _) = run(LinearSolverKind::Condensed, 2);
     assert!(q2.iter().zip(&qc).all(|(a, b)| a.to_bits() == b.to_bits()), "2 threads differ from 1 thread");
 }
+
+/// The fluid vehicle's mass shortcuts: only the rigid bodies' mass entries change with q (the
+/// fluids' consistent mass is constant), and its own `M a` (the fluids' M_s ⊗ I₃ from the scalar
+/// mass) is bit for bit the integrator's product over the pattern entries; the tank car run with
+/// them equals, bit for bit, the run with both hidden.
+#[test]
+fn the_mass_shortcuts_give_the_same_run_bit_for_bit() {
+    use rail_mbs::defaults::Oil;
+    use rail_mbs::integrator::{LinearSolverKind, SparsityPattern, SystemError};
+    use rail_mbs::track::Track;
+    use rail_mbs::vehicle::{FluidCargo, TankCarParams, TrainScenario, build_fluid_train};
+    use std::sync::Arc;
+
+    // unit checks on the free tank of `system(false)`, which rotates
+    let mut sys = system(false);
+    let (q0, v0) = sys.initial_coordinates();
+    let nd = sys.pattern().dynamics.len();
+    let (mut m0, mut m1) = (vec![0.0; nd], vec![0.0; nd]);
+    sys.mass(&q0, &mut m0).unwrap();
+    let mut q1 = q0.clone();
+    for (k, x) in q1.iter_mut().enumerate().take(7) {
+        *x += 0.1 * (k as f64 + 1.0).sin(); // moves and turns the tank body (unnormalized parameters are fine here)
+    }
+    sys.mass(&q1, &mut m1).unwrap();
+    let varying: std::collections::HashSet<usize> = sys.mass_varying_entries().unwrap().into_iter().collect();
+    assert!(varying.len() < nd / 10, "{} of {nd} entries declared varying", varying.len());
+    let changed: Vec<usize> = (0..nd).filter(|k| m0[*k] != m1[*k]).collect();
+    assert!(!changed.is_empty(), "the rigid mass must change with the Euler parameters");
+    assert!(changed.iter().all(|k| varying.contains(k)), "an entry outside the declared ones changed");
+    let mut part = m0.clone();
+    for &k in &varying {
+        part[k] = 0.0;
+    }
+    sys.mass_varying(&q1, &mut part).unwrap();
+    assert!(part.iter().zip(&m1).all(|(a, b)| a.to_bits() == b.to_bits()), "mass_varying on m(q0) != m(q1)");
+    let n = sys.n_coords();
+    let a: Vec<f64> = (0..n).map(|i| (0.37 * i as f64).sin() * 3.0 + v0[i]).collect();
+    let pattern = sys.pattern().dynamics;
+    let mut entries: Vec<(usize, usize, usize)> =
+        sys.mass_entries().unwrap().into_iter().map(|k| (pattern[k].0, pattern[k].1, k)).collect();
+    entries.sort_unstable();
+    entries.dedup();
+    let (scale, start) = (0.731, (0..n).map(|i| i as f64 * 0.01).collect::<Vec<_>>());
+    let mut by_pattern = start.clone();
+    for &(i, j, k) in &entries {
+        by_pattern[i] -= scale * m1[k] * a[j];
+    }
+    let mut own = start;
+    assert!(sys.subtract_mass_product(&m1, &a, scale, &mut own));
+    assert!(by_pattern.iter().zip(&own).all(|(x, y)| x.to_bits() == y.to_bits()), "M a differs");
+
+    /// The same system with the two shortcuts hidden (every other method forwarded).
+    struct Plain(FluidVehicle);
+    impl MechanicalSystem for Plain {
+        fn n_coords(&self) -> usize {
+            self.0.n_coords()
+        }
+        fn n_constraints(&self) -> usize {
+            self.0.n_constraints()
+        }
+        fn pattern(&self) -> SparsityPattern {
+            self.0.pattern()
+        }
+        fn mass_is_constant(&self) -> bool {
+            self.0.mass_is_constant()
+        }
+        fn linear_solver(&self) -> LinearSolverKind {
+            self.0.linear_solver()
+        }
+        fn condensed_blocks(&self) -> Vec<std::ops::Range<usize>> {
+            self.0.condensed_blocks()
+        }
+        fn mass_entries(&self) -> Option<Vec<usize>> {
+            self.0.mass_entries()
+        }
+        fn mass(&mut self, q: &[f64], v: &mut [f64]) -> Result<(), SystemError> {
+            self.0.mass(q, v)
+        }
+        fn forces(&mut self, t: f64, q: &[f64], v: &[f64], o: &mut [f64]) -> Result<(), SystemError> {
+            self.0.forces(t, q, v, o)
+        }
+        fn force_jacobians(
+            &mut self,
+            t: f64,
+            q: &[f64],
+            v: &[f64],
+            dq: &mut [f64],
+            dv: &mut [f64],
+        ) -> Result<(), SystemError> {
+            self.0.force_jacobians(t, q, v, dq, dv)
+        }
+        fn constraints(&mut self, t: f64, q: &[f64], o: &mut [f64]) -> Result<(), SystemError> {
+            self.0.constraints(t, q, o)
+        }
+        fn constraint_jacobian(&mut self, t: f64, q: &[f64], o: &mut [f64]) -> Result<(), SystemError> {
+            self.0.constraint_jacobian(t, q, o)
+        }
+        fn constraint_force_jacobian(
+            &mut self,
+            t: f64,
+            q: &[f64],
+            lambda: &[f64],
+            dq: &mut [f64],
+        ) -> Result<bool, SystemError> {
+            self.0.constraint_force_jacobian(t, q, lambda, dq)
+        }
+        fn check_step(&mut self, t: f64, q: &[f64], v: &[f64]) -> Result<(), SystemError> {
+            self.0.check_step(t, q, v)
+        }
+    }
+    let car = || {
+        let p = TankCarParams::standard().unwrap();
+        let fluid = Oil::Light.fluid(p.tank_radius, p.tank_radius / 2.0).unwrap();
+        let cargo = FluidCargo::new(fluid, [2, 2, 2], 0.5, vec![]);
+        let track = Arc::new(Track::straight(3000.0).unwrap());
+        let sc = TrainScenario::single(p, track, 300.0, 10.0, 1.0);
+        let (sys, _, _) = build_fluid_train(&sc, &cargo).unwrap();
+        (sys, sc.hht)
+    };
+    let (fast, params) = car();
+    let (q0, v0) = fast.initial_coordinates();
+    let mut a = Hht::new(fast, 0.0, q0.clone(), v0.clone(), params).unwrap();
+    let mut b = Hht::new(Plain(car().0), 0.0, q0, v0, params).unwrap();
+    a.integrate_to(0.02, 4e-3).unwrap();
+    b.integrate_to(0.02, 4e-3).unwrap();
+    assert_eq!(a.stats().newton_iterations, b.stats().newton_iterations);
+    for (x, y) in [(a.q(), b.q()), (a.v(), b.v()), (a.a(), b.a())] {
+        assert!(x.iter().zip(y).all(|(x, y)| x.to_bits() == y.to_bits()), "the runs differ");
+    }
+}

@@ -75,6 +75,11 @@ pub struct Hht<S: MechanicalSystem> {
     /// `(row, col, value index)` of the pattern entries that can hold mass, sorted by
     /// row: the product `M a` in the residual runs over these only.
     mass_nz: Vec<(u32, u32, u32)>,
+    /// The entries of a mass with a constant part that change with `q`
+    /// ([`MechanicalSystem::mass_varying_entries`]); `None`: the whole mass changes.
+    mass_varying: Option<Vec<usize>>,
+    /// Whether `mass_vals` holds a whole evaluation whose constant entries can be kept.
+    mass_base_valid: bool,
     // State at t_n.
     t: f64,
     q: Vec<f64>,
@@ -224,6 +229,12 @@ impl<S: MechanicalSystem> Hht<S> {
         let nc = pattern.constraints.len();
         let mass_constant = system.mass_is_constant();
         let mass_nz = mass_product_entries(&pattern, system.mass_entries());
+        let mass_varying = if mass_constant { None } else { system.mass_varying_entries() };
+        if let Some(&k) = mass_varying.as_ref().and_then(|v| v.iter().find(|&&k| k >= nd)) {
+            return Err(IntegratorError::InvalidSystem {
+                what: format!("varying mass entry {k} outside the {nd} pattern entries"),
+            });
+        }
         Ok(Self {
             system,
             params,
@@ -232,6 +243,8 @@ impl<S: MechanicalSystem> Hht<S> {
             pattern,
             mass_constant,
             mass_nz,
+            mass_varying,
+            mass_base_valid: false,
             t: t0,
             q: q0,
             v: v0,
@@ -273,10 +286,35 @@ impl<S: MechanicalSystem> Hht<S> {
     }
 
     fn eval_mass(&mut self, q_is_iterate: bool, t: f64) -> Result<(), IntegratorError> {
+        self.mass_base_valid = false;
         self.mass_vals.fill(0.0);
         let q = if q_is_iterate { &self.q_it } else { &self.q };
         self.system.mass(q, &mut self.mass_vals).map_err(sys_err(t))?;
-        check_finite(&self.mass_vals, t, Quantity::Mass)
+        check_finite(&self.mass_vals, t, Quantity::Mass)?;
+        self.mass_base_valid = true;
+        Ok(())
+    }
+
+    /// The mass at the iterate for a residual: only the varying entries when the system
+    /// declares them and a whole evaluation is held, else all of it.
+    fn eval_mass_iterate(&mut self, t1: f64) -> Result<(), IntegratorError> {
+        let Some(varying) = self.mass_varying.as_ref().filter(|_| self.mass_base_valid) else {
+            return self.eval_mass(true, t1);
+        };
+        for &k in varying {
+            self.mass_vals[k] = 0.0;
+        }
+        if let Err(e) = self.system.mass_varying(&self.q_it, &mut self.mass_vals) {
+            self.mass_base_valid = false;
+            return Err(sys_err(t1)(e));
+        }
+        match varying.iter().find(|&&k| !self.mass_vals[k].is_finite()) {
+            Some(&index) => {
+                self.mass_base_valid = false;
+                Err(IntegratorError::NonFinite { t: t1, what: Quantity::Mass, index })
+            }
+            None => Ok(()),
+        }
     }
 
     fn initial_acceleration(&mut self) -> Result<(), IntegratorError> {
@@ -421,9 +459,10 @@ impl<S: MechanicalSystem> Hht<S> {
     /// The system, mutably (e.g. to change a load). The sparsity pattern, `n`, `m`
     /// and constancy of `M` must not change.
     pub fn system_mut(&mut self) -> &mut S {
-        // The model may change: re-evaluate F_n and the Jacobians before reuse.
+        // The model may change: re-evaluate F_n, the Jacobians and the whole mass before reuse.
         self.f_old_valid = false;
         self.jac_valid = false;
+        self.mass_base_valid = false;
         &mut self.system
     }
     /// The system, mutably, for an observation that leaves the model unchanged (its
@@ -671,10 +710,9 @@ impl<S: MechanicalSystem> Hht<S> {
             }
         }
         if !self.mass_constant {
-            self.mass_vals.fill(0.0);
-            self.system.mass(&self.q_it, &mut self.mass_vals).map_err(sys_err(t1))?;
-            if let Err(e) = check_finite(&self.mass_vals, t1, Quantity::Mass) {
-                return Ok(Some(e));
+            match self.eval_mass_iterate(t1) {
+                Err(e @ IntegratorError::NonFinite { .. }) => return Ok(Some(e)),
+                r => r?,
             }
         }
         self.stats.residual_evaluations += 1;
@@ -791,8 +829,10 @@ impl<S: MechanicalSystem> Hht<S> {
                 }
             }
             let mass = if self.mass_constant { &self.mass_jac } else { &self.mass_vals };
-            for &(i, j, k) in &self.mass_nz {
-                r1[i as usize] -= c_m * mass[k as usize] * self.a_it[j as usize];
+            if !self.system.subtract_mass_product(mass, &self.a_it, c_m, r1) {
+                for &(i, j, k) in &self.mass_nz {
+                    r1[i as usize] -= c_m * mass[k as usize] * self.a_it[j as usize];
+                }
             }
             let scale_c = 1.0 / (beta * h * h);
             for (r, c) in r2.iter_mut().zip(&self.cval) {

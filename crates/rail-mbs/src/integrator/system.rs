@@ -103,6 +103,36 @@ pub trait MechanicalSystem {
     /// Mass-matrix values at `q`, in `pattern().dynamics` order, kg (or kg·m² …).
     fn mass(&mut self, q: &[f64], values: &mut [f64]) -> Result<(), SystemError>;
 
+    /// Optional, for a mass matrix of which only a part depends on `q` (rigid bodies beside a
+    /// fluid's constant consistent mass): the indices into `pattern().dynamics` of the entries
+    /// that can change with `q`. With `Some`, the integrator evaluates the whole mass once with
+    /// [`mass`](MechanicalSystem::mass), keeps the other entries, and at each residual zeroes
+    /// only these and calls [`mass_varying`](MechanicalSystem::mass_varying), which must then
+    /// be implemented. Ignored when [`mass_is_constant`](MechanicalSystem::mass_is_constant).
+    /// Default `None`: the whole mass at every residual.
+    fn mass_varying_entries(&self) -> Option<Vec<usize>> {
+        None
+    }
+
+    /// The entries of [`mass_varying_entries`](MechanicalSystem::mass_varying_entries) at `q`,
+    /// written as [`mass`](MechanicalSystem::mass) writes them (into entries the integrator
+    /// has zeroed); every other entry must be left as it is. Default: [`mass`](MechanicalSystem::mass),
+    /// right only for a system that declares no such entries.
+    fn mass_varying(&mut self, q: &[f64], values: &mut [f64]) -> Result<(), SystemError> {
+        self.mass(q, values)
+    }
+
+    /// Optional, faster than the integrator's product over the pattern entries for a mass with
+    /// structure (a fluid's consistent mass is M_s ⊗ I₃): `out[i] −= (scale · M_ij) · a[j]` for
+    /// every entry of M, with `M` the values `values` (`pattern().dynamics` order, as
+    /// [`mass`](MechanicalSystem::mass) wrote them), taking each row's entries by increasing
+    /// column, so that the result is bit for bit the integrator's own. Returns whether it did;
+    /// default `false`.
+    fn subtract_mass_product(&self, values: &[f64], a: &[f64], scale: f64, out: &mut [f64]) -> bool {
+        let _ = (values, a, scale, out);
+        false
+    }
+
     /// Generalized forces `Q(t, q, v)` (applied minus internal), length `n`.
     fn forces(&mut self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) -> Result<(), SystemError>;
 

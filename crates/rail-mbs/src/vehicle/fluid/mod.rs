@@ -80,6 +80,8 @@ pub struct FluidVehicle {
     pub linear_solver: LinearSolverKind,
     layouts: Vec<FluidLayout>,
     mb_entries: usize,
+    /// The rigid bodies' mass entries (row, column, pattern index), sorted by row and column.
+    rigid_mass: Vec<(u32, u32, u32)>,
     n_rigid: usize,
     point_jac: Vec<PointJacobian>,
     /// Force buffers of each fluid (no allocation per force evaluation).
@@ -115,7 +117,16 @@ impl FluidVehicle {
                 return Err(ancf_core::error::invalid("fluid tank body", f.tank.0, "an existing body"));
             }
         }
-        let mb_entries = mb.pattern().dynamics.len();
+        let mb_pattern = mb.pattern().dynamics;
+        let mb_entries = mb_pattern.len();
+        let mut rigid_mass: Vec<(u32, u32, u32)> = mb
+            .mass_entries()
+            .unwrap_or_else(|| (0..mb_entries).collect())
+            .into_iter()
+            .map(|k| (mb_pattern[k].0 as u32, mb_pattern[k].1 as u32, k as u32))
+            .collect();
+        rigid_mass.sort_unstable();
+        rigid_mass.dedup();
         let workspaces = vec![ForceWorkspace::default(); fluids.len()];
         let mut s = Self {
             mb,
@@ -123,6 +134,7 @@ impl FluidVehicle {
             linear_solver: LinearSolverKind::Condensed,
             layouts: Vec::new(),
             mb_entries,
+            rigid_mass,
             n_rigid,
             point_jac: Vec::new(),
             workspaces,
@@ -326,14 +338,48 @@ impl MechanicalSystem for FluidVehicle {
     }
 
     fn mass(&mut self, q: &[f64], values: &mut [f64]) -> Result<(), SystemError> {
-        let nr = self.n_rigid;
-        self.mb.mass(&q[..nr], &mut values[..self.mb_entries])?;
+        self.mass_varying(q, values)?;
         for lay in &self.layouts {
             for &(i, val) in &lay.mass_entries {
                 values[i] += val;
             }
         }
         Ok(())
+    }
+
+    /// The rigid bodies' mass blocks change with their Euler parameters; the fluids' consistent
+    /// mass (most of the entries) is constant, so the integrator keeps it between residuals.
+    fn mass_varying_entries(&self) -> Option<Vec<usize>> {
+        Some(self.mb.mass_entries().unwrap_or_else(|| (0..self.mb_entries).collect()))
+    }
+
+    fn mass_varying(&mut self, q: &[f64], values: &mut [f64]) -> Result<(), SystemError> {
+        let nr = self.n_rigid;
+        self.mb.mass(&q[..nr], &mut values[..self.mb_entries])
+    }
+
+    /// The rigid bodies' blocks from `values`, each fluid's M_s ⊗ I₃ from its scalar mass (the
+    /// values `mass` writes there, unchanged): a third of the index traffic of the pattern's
+    /// entries, the same sums in the same order.
+    fn subtract_mass_product(&self, values: &[f64], a: &[f64], scale: f64, out: &mut [f64]) -> bool {
+        for &(i, j, k) in &self.rigid_mass {
+            out[i as usize] -= scale * values[k as usize] * a[j as usize];
+        }
+        for (f, lay) in self.fluids.iter().zip(&self.layouts) {
+            let m = f.body.scalar_mass().as_ref();
+            let (o, n) = (lay.offset, f.body.n_coords());
+            let (out, a) = (&mut out[o..o + n], &a[o..o + n]);
+            for j in 0..m.ncols() {
+                let aj = [a[3 * j], a[3 * j + 1], a[3 * j + 2]];
+                for (i, val) in m.row_idx_of_col(j).zip(m.val_of_col(j)) {
+                    let c = scale * val;
+                    for d in 0..3 {
+                        out[3 * i + d] -= c * aj[d];
+                    }
+                }
+            }
+        }
+        true
     }
 
     /// The rigid forces, then each fluid's internal, gravity and wall-contact forces and its
