@@ -171,6 +171,22 @@ impl FluidBody {
         &self.scalar_mass
     }
 
+    /// `out[i] −= (scale · M_ij) · a[j]` for the full mass M = M_s ⊗ I₃ (`a`, `out`: this
+    /// body's coordinates), each row's terms by increasing column: the same sums as a product
+    /// over M's entries sorted by row and column, with a third of the index traffic.
+    pub fn subtract_mass_product(&self, a: &[f64], scale: f64, out: &mut [f64]) {
+        let m = self.scalar_mass.as_ref();
+        for j in 0..m.ncols() {
+            let aj = [a[3 * j], a[3 * j + 1], a[3 * j + 2]];
+            for (i, val) in m.row_idx_of_col(j).zip(m.val_of_col(j)) {
+                let c = scale * val;
+                for d in 0..3 {
+                    out[3 * i + d] -= c * aj[d];
+                }
+            }
+        }
+    }
+
     /// Total mass ∫ρ dV₀ (sum of the position–position block of M_s).
     pub fn total_mass(&self) -> f64 {
         self.gravity_scale.iter().step_by(4).sum()

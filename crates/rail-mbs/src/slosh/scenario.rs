@@ -177,6 +177,29 @@ mod tests {
     }
 
     #[test]
+    fn the_systems_mass_product_is_the_pattern_product_bit_for_bit() {
+        use crate::integrator::MechanicalSystem;
+        let mut sys = box_scenario().build_system().unwrap();
+        let n = sys.n_coords();
+        let pattern = sys.pattern().dynamics;
+        let mut m = vec![0.0; pattern.len()];
+        sys.mass(&vec![0.0; n], &mut m).unwrap();
+        let mut entries: Vec<(usize, usize, usize)> =
+            sys.mass_entries().unwrap().into_iter().map(|k| (pattern[k].0, pattern[k].1, k)).collect();
+        entries.sort_unstable();
+        let a: Vec<f64> = (0..n).map(|i| (0.61 * i as f64).cos() * 7.0).collect();
+        let (scale, start) = (1.37, (0..n).map(|i| 1e-3 * i as f64).collect::<Vec<_>>());
+        let mut by_pattern = start.clone();
+        for &(i, j, k) in &entries {
+            by_pattern[i] -= scale * m[k] * a[j];
+        }
+        let mut own = start.clone();
+        assert!(sys.subtract_mass_product(&m, &a, scale, &mut own));
+        assert!(by_pattern.iter().zip(&own).all(|(x, y)| x.to_bits() == y.to_bits()));
+        assert!(by_pattern.iter().zip(&start).any(|(x, y)| (x - y).abs() > 1.0), "a product far from zero");
+    }
+
+    #[test]
     fn the_wall_law_scales_stiffness_and_keeps_the_damping_ratio() {
         let mut sc = box_scenario();
         let base = sc.wall_law().unwrap();

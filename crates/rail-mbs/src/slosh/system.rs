@@ -310,6 +310,13 @@ impl MechanicalSystem for SloshSystem {
         Ok(())
     }
 
+    /// M_s ⊗ I₃ from the scalar mass ([`FluidBody::subtract_mass_product`]), the values
+    /// [`Self::mass`] writes: bit for bit the integrator's product over the pattern entries.
+    fn subtract_mass_product(&self, _values: &[f64], a: &[f64], scale: f64, out: &mut [f64]) -> bool {
+        self.body.subtract_mass_product(a, scale, out);
+        true
+    }
+
     fn forces(&mut self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) -> Result<(), SystemError> {
         self.body.internal_forces_with(&mut self.workspace, q, v, out).map_err(SystemError::from)?;
         out.iter_mut().for_each(|x| *x = -*x);

@@ -366,18 +366,8 @@ impl MechanicalSystem for FluidVehicle {
             out[i as usize] -= scale * values[k as usize] * a[j as usize];
         }
         for (f, lay) in self.fluids.iter().zip(&self.layouts) {
-            let m = f.body.scalar_mass().as_ref();
             let (o, n) = (lay.offset, f.body.n_coords());
-            let (out, a) = (&mut out[o..o + n], &a[o..o + n]);
-            for j in 0..m.ncols() {
-                let aj = [a[3 * j], a[3 * j + 1], a[3 * j + 2]];
-                for (i, val) in m.row_idx_of_col(j).zip(m.val_of_col(j)) {
-                    let c = scale * val;
-                    for d in 0..3 {
-                        out[3 * i + d] -= c * aj[d];
-                    }
-                }
-            }
+            f.body.subtract_mass_product(&a[o..o + n], scale, &mut out[o..o + n]);
         }
         true
     }
