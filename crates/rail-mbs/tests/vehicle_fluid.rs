@@ -156,6 +156,75 @@ fn fluid_weight_is_carried_by_the_tank_springs() {
 /// every entry `mass` writes, at a rotated tank state, for the monolithic system and for a
 /// fluid in a prescribed-motion tank; and the integrator gives the same first step with and
 /// without the declaration.
+/// A fluid vehicle with its mass shortcuts hidden (`mass_varying_entries`, `subtract_mass_product`)
+/// and, without `mass_entries`, its declaration of the mass entries: every other method forwarded.
+struct Plain {
+    sys: FluidVehicle,
+    mass_entries: bool,
+}
+impl MechanicalSystem for Plain {
+    fn n_coords(&self) -> usize {
+        self.sys.n_coords()
+    }
+    fn n_constraints(&self) -> usize {
+        self.sys.n_constraints()
+    }
+    fn pattern(&self) -> rail_mbs::integrator::SparsityPattern {
+        self.sys.pattern()
+    }
+    fn mass_is_constant(&self) -> bool {
+        self.sys.mass_is_constant()
+    }
+    fn linear_solver(&self) -> rail_mbs::integrator::LinearSolverKind {
+        self.sys.linear_solver()
+    }
+    fn condensed_blocks(&self) -> Vec<std::ops::Range<usize>> {
+        self.sys.condensed_blocks()
+    }
+    fn mass_entries(&self) -> Option<Vec<usize>> {
+        if self.mass_entries { self.sys.mass_entries() } else { None }
+    }
+    fn mass(&mut self, q: &[f64], v: &mut [f64]) -> Result<(), rail_mbs::integrator::SystemError> {
+        self.sys.mass(q, v)
+    }
+    fn forces(&mut self, t: f64, q: &[f64], v: &[f64], o: &mut [f64]) -> Result<(), rail_mbs::integrator::SystemError> {
+        self.sys.forces(t, q, v, o)
+    }
+    fn force_jacobians(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        dq: &mut [f64],
+        dv: &mut [f64],
+    ) -> Result<(), rail_mbs::integrator::SystemError> {
+        self.sys.force_jacobians(t, q, v, dq, dv)
+    }
+    fn constraints(&mut self, t: f64, q: &[f64], o: &mut [f64]) -> Result<(), rail_mbs::integrator::SystemError> {
+        self.sys.constraints(t, q, o)
+    }
+    fn constraint_jacobian(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        o: &mut [f64],
+    ) -> Result<(), rail_mbs::integrator::SystemError> {
+        self.sys.constraint_jacobian(t, q, o)
+    }
+    fn constraint_force_jacobian(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        lambda: &[f64],
+        dq: &mut [f64],
+    ) -> Result<bool, rail_mbs::integrator::SystemError> {
+        self.sys.constraint_force_jacobian(t, q, lambda, dq)
+    }
+    fn check_step(&mut self, t: f64, q: &[f64], v: &[f64]) -> Result<(), rail_mbs::integrator::SystemError> {
+        self.sys.check_step(t, q, v)
+    }
+}
+
 #[test]
 fn declared_mass_entries_cover_the_mass_matrix() {
     let mut sys = system(false);
@@ -173,56 +242,10 @@ fn declared_mass_entries_cover_the_mass_matrix() {
     );
     assert!(declared.len() < nd / 2, "declared {} of {nd} entries", declared.len());
 
-    /// The same system with the declaration hidden: `M a` over every pattern entry.
-    struct Undeclared(FluidVehicle);
-    impl MechanicalSystem for Undeclared {
-        fn n_coords(&self) -> usize {
-            self.0.n_coords()
-        }
-        fn n_constraints(&self) -> usize {
-            self.0.n_constraints()
-        }
-        fn pattern(&self) -> rail_mbs::integrator::SparsityPattern {
-            self.0.pattern()
-        }
-        fn mass(&mut self, q: &[f64], v: &mut [f64]) -> Result<(), rail_mbs::integrator::SystemError> {
-            self.0.mass(q, v)
-        }
-        fn forces(
-            &mut self,
-            t: f64,
-            q: &[f64],
-            v: &[f64],
-            o: &mut [f64],
-        ) -> Result<(), rail_mbs::integrator::SystemError> {
-            self.0.forces(t, q, v, o)
-        }
-        fn force_jacobians(
-            &mut self,
-            t: f64,
-            q: &[f64],
-            v: &[f64],
-            dq: &mut [f64],
-            dv: &mut [f64],
-        ) -> Result<(), rail_mbs::integrator::SystemError> {
-            self.0.force_jacobians(t, q, v, dq, dv)
-        }
-        fn constraints(&mut self, t: f64, q: &[f64], o: &mut [f64]) -> Result<(), rail_mbs::integrator::SystemError> {
-            self.0.constraints(t, q, o)
-        }
-        fn constraint_jacobian(
-            &mut self,
-            t: f64,
-            q: &[f64],
-            o: &mut [f64],
-        ) -> Result<(), rail_mbs::integrator::SystemError> {
-            self.0.constraint_jacobian(t, q, o)
-        }
-    }
     let (q0, v0) = sys.initial_coordinates();
     let params = rail_mbs::integrator::HhtParams { abs_tol_acc: 1e-6, max_iterations: 20, ..Default::default() };
     let mut a = Hht::new(system(false), 0.0, q0.clone(), v0.clone(), params).unwrap();
-    let mut b = Hht::new(Undeclared(system(false)), 0.0, q0, v0, params).unwrap();
+    let mut b = Hht::new(Plain { sys: system(false), mass_entries: false }, 0.0, q0, v0, params).unwrap();
     a.step(1e-3).unwrap();
     b.step(1e-3).unwrap();
     let dev = a.q().iter().zip(b.q()).fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
@@ -327,7 +350,6 @@ fn condensed_and_direct_solves_give_the_same_train_run() {
 #[test]
 fn the_mass_shortcuts_give_the_same_run_bit_for_bit() {
     use rail_mbs::defaults::Oil;
-    use rail_mbs::integrator::{LinearSolverKind, SparsityPattern, SystemError};
     use rail_mbs::track::Track;
     use rail_mbs::vehicle::{FluidCargo, TankCarParams, TrainScenario, build_fluid_train};
     use std::sync::Arc;
@@ -370,65 +392,6 @@ fn the_mass_shortcuts_give_the_same_run_bit_for_bit() {
     assert!(sys.subtract_mass_product(&m1, &a, scale, &mut own));
     assert!(by_pattern.iter().zip(&own).all(|(x, y)| x.to_bits() == y.to_bits()), "M a differs");
 
-    /// The same system with the two shortcuts hidden (every other method forwarded).
-    struct Plain(FluidVehicle);
-    impl MechanicalSystem for Plain {
-        fn n_coords(&self) -> usize {
-            self.0.n_coords()
-        }
-        fn n_constraints(&self) -> usize {
-            self.0.n_constraints()
-        }
-        fn pattern(&self) -> SparsityPattern {
-            self.0.pattern()
-        }
-        fn mass_is_constant(&self) -> bool {
-            self.0.mass_is_constant()
-        }
-        fn linear_solver(&self) -> LinearSolverKind {
-            self.0.linear_solver()
-        }
-        fn condensed_blocks(&self) -> Vec<std::ops::Range<usize>> {
-            self.0.condensed_blocks()
-        }
-        fn mass_entries(&self) -> Option<Vec<usize>> {
-            self.0.mass_entries()
-        }
-        fn mass(&mut self, q: &[f64], v: &mut [f64]) -> Result<(), SystemError> {
-            self.0.mass(q, v)
-        }
-        fn forces(&mut self, t: f64, q: &[f64], v: &[f64], o: &mut [f64]) -> Result<(), SystemError> {
-            self.0.forces(t, q, v, o)
-        }
-        fn force_jacobians(
-            &mut self,
-            t: f64,
-            q: &[f64],
-            v: &[f64],
-            dq: &mut [f64],
-            dv: &mut [f64],
-        ) -> Result<(), SystemError> {
-            self.0.force_jacobians(t, q, v, dq, dv)
-        }
-        fn constraints(&mut self, t: f64, q: &[f64], o: &mut [f64]) -> Result<(), SystemError> {
-            self.0.constraints(t, q, o)
-        }
-        fn constraint_jacobian(&mut self, t: f64, q: &[f64], o: &mut [f64]) -> Result<(), SystemError> {
-            self.0.constraint_jacobian(t, q, o)
-        }
-        fn constraint_force_jacobian(
-            &mut self,
-            t: f64,
-            q: &[f64],
-            lambda: &[f64],
-            dq: &mut [f64],
-        ) -> Result<bool, SystemError> {
-            self.0.constraint_force_jacobian(t, q, lambda, dq)
-        }
-        fn check_step(&mut self, t: f64, q: &[f64], v: &[f64]) -> Result<(), SystemError> {
-            self.0.check_step(t, q, v)
-        }
-    }
     let car = || {
         let p = TankCarParams::standard().unwrap();
         let fluid = Oil::Light.fluid(p.tank_radius, p.tank_radius / 2.0).unwrap();
@@ -441,7 +404,7 @@ fn the_mass_shortcuts_give_the_same_run_bit_for_bit() {
     let (fast, params) = car();
     let (q0, v0) = fast.initial_coordinates();
     let mut a = Hht::new(fast, 0.0, q0.clone(), v0.clone(), params).unwrap();
-    let mut b = Hht::new(Plain(car().0), 0.0, q0, v0, params).unwrap();
+    let mut b = Hht::new(Plain { sys: car().0, mass_entries: true }, 0.0, q0, v0, params).unwrap();
     a.integrate_to(0.02, 4e-3).unwrap();
     b.integrate_to(0.02, 4e-3).unwrap();
     assert_eq!(a.stats().newton_iterations, b.stats().newton_iterations);
