@@ -486,6 +486,35 @@ def _time_over(t: np.ndarray, da: Any, limit: float, min_duration: float) -> np.
     return _per_channel(da, lambda x: time_over_limit(t, x, limit, min_duration))
 
 
+def _add_peak_and_time_over(
+    out: Any,
+    name: str,
+    da: Any,
+    t: np.ndarray,
+    dur: float,
+    standard: str,
+    limit_attrs: dict[str, Any],
+    *,
+    peak: str,
+    over: str,
+    peak_only: dict[str, Any] | None = None,
+) -> None:
+    """``{name}_max``, the largest value of ``da`` (time, ...) per channel, and
+    ``{name}_time_over_limit``, the time it stays above ``limit_attrs["limit"]`` in spells of at
+    least ``dur`` s (:func:`time_over_limit`), both with ``limit_attrs`` among their attributes."""
+    dims = tuple(d for d in da.dims if d != "time")
+    out[f"{name}_max"] = (
+        dims,
+        np.asarray(da.max("time").values, dtype=float),
+        _attrs("1", peak, standard, **(peak_only or {}), **limit_attrs),
+    )
+    out[f"{name}_time_over_limit"] = (
+        dims,
+        _time_over(t, da, limit_attrs["limit"], dur),
+        _attrs("s", f"time {over} in spells ≥ {dur * 1e3:g} ms", standard, min_duration=dur, **limit_attrs),
+    )
+
+
 def _add_derailment(
     out: Any,
     ds: Any,
@@ -521,21 +550,17 @@ def _add_derailment(
         "friction": float(friction),
         "wheel_profile": wheel_profile(ds),
     }
-    out["l_over_v_max"] = (
-        ("wheelset", "side"),
-        np.asarray(lv.max("time").values, dtype=float),
-        _attrs("1", f"largest wheel L/V = |Y|/Q {within}", nadal_std, source=lv_note, **lim_attrs),
-    )
-    out["l_over_v_time_over_limit"] = (
-        ("wheelset", "side"),
-        _time_over(t, lv, nadal, dur),
-        _attrs(
-            "s",
-            f"time the wheel L/V stays above Nadal's limit {nadal:.3f} in spells ≥ {dur * 1e3:g} ms",
-            nadal_std,
-            min_duration=dur,
-            **lim_attrs,
-        ),
+    _add_peak_and_time_over(
+        out,
+        "l_over_v",
+        lv,
+        t,
+        dur,
+        nadal_std,
+        lim_attrs,
+        peak=f"largest wheel L/V = |Y|/Q {within}",
+        over=f"the wheel L/V stays above Nadal's limit {nadal:.3f}",
+        peak_only={"source": lv_note},
     )
     ws = weinstock_sum(np.asarray(lv_all.transpose("time", "wheelset", "side").values, dtype=float))
     wstd = f"Weinstock (1984) axle-sum L/V; limit {WEINSTOCK_LIMIT:g}: AAR MSRP C-II Chapter XI; {_AAR_DURATION}"
@@ -544,22 +569,16 @@ def _add_derailment(
         ws,
         _attrs("1", "axle sum of the wheel L/V ratios |Y_l|/Q_l + |Y_r|/Q_r (Weinstock)", wstd, limit=WEINSTOCK_LIMIT),
     )
-    wpart = out["weinstock"].sel(time=part["time"])
-    out["weinstock_max"] = (
-        ("wheelset",),
-        np.asarray(wpart.max("time").values, dtype=float),
-        _attrs("1", f"largest axle-sum L/V (Weinstock) {within}", wstd, limit=WEINSTOCK_LIMIT),
-    )
-    out["weinstock_time_over_limit"] = (
-        ("wheelset",),
-        _time_over(t, wpart, WEINSTOCK_LIMIT, dur),
-        _attrs(
-            "s",
-            f"time the axle-sum L/V stays above {WEINSTOCK_LIMIT:g} in spells ≥ {dur * 1e3:g} ms",
-            wstd,
-            limit=WEINSTOCK_LIMIT,
-            min_duration=dur,
-        ),
+    _add_peak_and_time_over(
+        out,
+        "weinstock",
+        out["weinstock"].sel(time=part["time"]),
+        t,
+        dur,
+        wstd,
+        {"limit": WEINSTOCK_LIMIT},
+        peak=f"largest axle-sum L/V (Weinstock) {within}",
+        over=f"the axle-sum L/V stays above {WEINSTOCK_LIMIT:g}",
     )
     q_all = ds["wheel_vertical"].transpose("time", "wheelset", "side")
     if static_load is not None:
@@ -583,22 +602,16 @@ def _add_derailment(
         q0,
         _attrs("N", "static wheel load Q0 of the unloading ΔQ/Q0", UNLOADING_STANDARD, source=q0_note),
     )
-    out["unloading_max"] = (
-        ("wheelset", "side"),
-        np.asarray(unl_da.max("time").values),
-        _attrs("1", f"largest wheel unloading (Q0 − Q)/Q0 {within}", ustd, limit=unl_lim, reference=q0_note),
-    )
-    out["unloading_time_over_limit"] = (
-        ("wheelset", "side"),
-        _time_over(t, unl_da, unl_lim, dur),
-        _attrs(
-            "s",
-            f"time the wheel unloading stays above {unl_lim:g} in spells ≥ {dur * 1e3:g} ms",
-            ustd,
-            limit=unl_lim,
-            min_duration=dur,
-            reference=q0_note,
-        ),
+    _add_peak_and_time_over(
+        out,
+        "unloading",
+        unl_da,
+        t,
+        dur,
+        ustd,
+        {"limit": unl_lim, "reference": q0_note},
+        peak=f"largest wheel unloading (Q0 − Q)/Q0 {within}",
+        over=f"the wheel unloading stays above {unl_lim:g}",
     )
     return out, q_all
 
