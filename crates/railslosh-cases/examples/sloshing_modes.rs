@@ -19,7 +19,7 @@ use ancf_core::element::QuadratureOptions;
 use faer::Mat;
 use faer::linalg::solvers::Solve;
 use rail_mbs::integrator::MechanicalSystem;
-use rail_mbs::slosh::{PiecewiseAcceleration, SloshScenario};
+use rail_mbs::slosh::{PiecewiseAcceleration, SloshScenario, mass_normalized_eigen};
 use railslosh_cases::slosh::RestMesh;
 
 fn env(name: &str, default: f64) -> f64 {
@@ -64,16 +64,11 @@ fn main() {
             out.iter_mut().for_each(|x| *x = 0.0);
             contact.forces(&sys.body, &kin, qq, vv, out, None);
         });
-        let l_m = m.llt(faer::Side::Lower).unwrap().L().to_owned();
+        // eigenvalues of −K_sym against M
         let lowest = |k: &Mat<f64>| -> Vec<String> {
-            // eigenvalues of L⁻¹ (−K_sym) L⁻ᵀ, M = L Lᵀ
-            let mut b = Mat::<f64>::from_fn(n, n, |i, j| -0.5 * (k[(i, j)] + k[(j, i)]));
-            faer::linalg::triangular_solve::solve_lower_triangular_in_place(l_m.as_ref(), b.as_mut(), faer::Par::Seq);
-            let mut a = b.transpose().to_owned();
-            faer::linalg::triangular_solve::solve_lower_triangular_in_place(l_m.as_ref(), a.as_mut(), faer::Par::Seq);
-            let a = Mat::<f64>::from_fn(n, n, |i, j| 0.5 * (a[(i, j)] + a[(j, i)]));
-            let ev = a.self_adjoint_eigenvalues(faer::Side::Lower).unwrap();
-            ev[..4].iter().map(|x| format!("{x:.1}")).collect()
+            let neg = Mat::<f64>::from_fn(n, n, |i, j| -k[(i, j)]);
+            let (w, _) = mass_normalized_eigen(&m, &neg).unwrap();
+            w[..4].iter().map(|x| format!("{x:.1}")).collect()
         };
         let kf = &kq - &kc;
         println!("  lowest omega^2 of -K_sym/M: contact {:?}, the rest {:?}", lowest(&kc), lowest(&kf));

@@ -12,7 +12,7 @@ pub mod motion;
 pub mod scenario;
 pub mod system;
 
-pub use modes::{LinearModes, linear_modes};
+pub use modes::{LinearModes, linear_modes, mass_normalized_eigen};
 pub use motion::{PiecewiseAcceleration, PrescribedMotion, TankFrameInput, TankFrameSample, TankState};
 pub use scenario::SloshScenario;
 pub use system::{SloshFrame, SloshSystem};

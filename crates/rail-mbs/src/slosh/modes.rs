@@ -50,6 +50,27 @@ impl LinearModes {
     }
 }
 
+/// The eigenpairs of K_sym φ = ω² M φ for dense `m` (symmetric positive definite) and `k`
+/// (its symmetric part is used), ascending in ω², with φᵀ M φ = 1 (module docs: M = L Lᵀ,
+/// (L⁻¹ K L⁻ᵀ) y = ω² y, φ = L⁻ᵀ y).
+pub fn mass_normalized_eigen(m: &Mat<f64>, k: &Mat<f64>) -> Result<(Vec<f64>, Mat<f64>), SystemError> {
+    let n = m.nrows();
+    let err = |what: &str| SystemError::Other(format!("linear modes: {what}"));
+    let llt = m.llt(Side::Lower).map_err(|e| err(&format!("mass matrix not positive definite: {e:?}")))?;
+    let l = llt.L().to_owned();
+    // A = L⁻¹ K_sym L⁻ᵀ: B = L⁻¹ K_sym, then A = L⁻¹ Bᵀ (K_sym symmetric)
+    let mut b = Mat::<f64>::from_fn(n, n, |i, j| 0.5 * (k[(i, j)] + k[(j, i)]));
+    faer::linalg::triangular_solve::solve_lower_triangular_in_place(l.as_ref(), b.as_mut(), Par::Seq);
+    let mut a = b.transpose().to_owned();
+    faer::linalg::triangular_solve::solve_lower_triangular_in_place(l.as_ref(), a.as_mut(), Par::Seq);
+    let a = Mat::<f64>::from_fn(n, n, |i, j| 0.5 * (a[(i, j)] + a[(j, i)]));
+    let eig = a.self_adjoint_eigen(Side::Lower).map_err(|e| err(&format!("eigensolver: {e:?}")))?;
+    let omega_sq: Vec<f64> = (0..n).map(|c| eig.S()[c]).collect();
+    let mut shapes = eig.U().to_owned();
+    faer::linalg::triangular_solve::solve_upper_triangular_in_place(l.transpose(), shapes.as_mut(), Par::Seq);
+    Ok((omega_sq, shapes))
+}
+
 /// Linear modes of `sys` about the state `q` at rest at time `t` (the tank must be at rest
 /// there; `q` should be a settled equilibrium, otherwise K also holds the residual's terms).
 pub fn linear_modes(sys: &mut SloshSystem, t: f64, q: &[f64]) -> Result<LinearModes, SystemError> {
@@ -67,19 +88,7 @@ pub fn linear_modes(sys: &mut SloshSystem, t: f64, q: &[f64]) -> Result<LinearMo
         m[(i, j)] += mv[idx];
         k[(i, j)] -= dq[idx];
     }
-    let err = |what: &str| SystemError::Other(format!("linear modes: {what}"));
-    let llt = m.llt(Side::Lower).map_err(|e| err(&format!("mass matrix not positive definite: {e:?}")))?;
-    let l = llt.L().to_owned();
-    // A = L⁻¹ K_sym L⁻ᵀ: B = L⁻¹ K_sym, then A = L⁻¹ Bᵀ (K_sym symmetric)
-    let mut b = Mat::<f64>::from_fn(n, n, |i, j| 0.5 * (k[(i, j)] + k[(j, i)]));
-    faer::linalg::triangular_solve::solve_lower_triangular_in_place(l.as_ref(), b.as_mut(), Par::Seq);
-    let mut a = b.transpose().to_owned();
-    faer::linalg::triangular_solve::solve_lower_triangular_in_place(l.as_ref(), a.as_mut(), Par::Seq);
-    let a = Mat::<f64>::from_fn(n, n, |i, j| 0.5 * (a[(i, j)] + a[(j, i)]));
-    let eig = a.self_adjoint_eigen(Side::Lower).map_err(|e| err(&format!("eigensolver: {e:?}")))?;
-    let omega_sq: Vec<f64> = (0..n).map(|c| eig.S()[c]).collect();
-    let mut shapes = eig.U().to_owned();
-    faer::linalg::triangular_solve::solve_upper_triangular_in_place(l.transpose(), shapes.as_mut(), Par::Seq);
+    let (omega_sq, shapes) = mass_normalized_eigen(&m, &k)?;
     // M r_d for the three rigid translations: column sums of M over the position components d
     let mut mr = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
     for (idx, &(i, j)) in pattern.iter().enumerate() {
