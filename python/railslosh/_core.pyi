@@ -308,8 +308,10 @@ def wheel_rail_contact(
 
 # --- vehicle (crates/railslosh-py/src/vehicle.rs) ---
 
-def tank_car_parameters(car: dict[str, float] | None = None, wheel_profile: str = "s1002") -> dict[str, Any]: ...
-def wheelset_stations(cars: int = 1, station: float = 50.0, car: dict[str, float] | None = None) -> list[float]: ...
+def tank_car_parameters(car: dict[str, float | str] | None = None, wheel_profile: str = "s1002") -> dict[str, Any]: ...
+def wheelset_stations(
+    cars: int = 1, station: float = 50.0, car: dict[str, float | str] | None = None
+) -> list[float]: ...
 def track_irregularity(
     kind: str,
     length: float,
@@ -354,7 +356,7 @@ def run_train(
     wheelset_lateral_offset: float = 0.0,
     coupler_stiffness: float | None = None,
     coupler_damping: float | None = None,
-    car: dict[str, float] | None = None,
+    car: dict[str, float | str] | None = None,
     progress: _Progress | None = None,
     stream: str | None = None,
     friction_map: dict[str, Any] | None = None,
@@ -385,7 +387,7 @@ def run_fluid_train(
     fill: float = 0.5,
     bulkheads: list[tuple[float, float]] | None = None,
     wheel_profile: str = "s1002",
-    car: dict[str, float] | None = None,
+    car: dict[str, float | str] | None = None,
     progress: _Progress | None = None,
     stream: str | None = None,
     wall_damping_ratio: float = ...,
@@ -417,7 +419,7 @@ def run_equivalent_train(
     lading_mass: float = 0.0,
     lading_height: float = 0.0,
     wheel_profile: str = "s1002",
-    car: dict[str, float] | None = None,
+    car: dict[str, float | str] | None = None,
     progress: _Progress | None = None,
     stream: str | None = None,
     friction_map: dict[str, Any] | None = None,
@@ -429,7 +431,7 @@ def equivalent_model(
     fluid: Fluid | None = None,
     bulkheads: list[tuple[float, float]] | None = None,
     slosh_axis: str = "longitudinal",
-    car: dict[str, float] | None = None,
+    car: dict[str, float | str] | None = None,
 ) -> dict[str, Any]: ...
 def hat_mean_resample(t: Sequence[float], values: Sequence[Sequence[float]], dt: float) -> npt.NDArray[np.float64]: ...
 def equivalent_lambda(depth_fraction: float) -> float: ...

@@ -9,7 +9,9 @@ of such cars joined by couplers, run on a track with rigid lading.
 
 Every car parameter has a documented default (``tank_car_parameters()`` lists them with the
 DOF count; sources in the Rust docs of ``rail_mbs::vehicle::TankCarParams``) and can be
-overridden with ``car={"wheelbase": 1.778, ...}``. Units are SI; wheel arrays are ordered front to
+overridden with ``car={"wheelbase": 1.778, ...}``; ``car={"truck": "three_piece"}`` builds each bogie as a
+warp-capable three-piece freight truck instead of seed 000's rigid frame
+(``rail_mbs::vehicle::TruckModel``; docs/user-guide.md, "Bogie model"). Units are SI; wheel arrays are ordered front to
 rear over all cars, ``[left, right]`` looking forward; lateral forces are positive to the track's
 left; coupler forces are positive in tension.
 """
@@ -45,12 +47,14 @@ __all__ = [
 ]
 
 
-def tank_car_parameters(car: dict[str, float] | None = None, wheel_profile: str = "s1002") -> dict[str, float]:
-    """Default (or overridden) scalar parameters of the tank car, its total mass and DOF count."""
+def tank_car_parameters(car: dict[str, float | str] | None = None, wheel_profile: str = "s1002") -> dict[str, float]:
+    """Default (or overridden) scalar parameters of the tank car, its total mass and DOF count. ``car``
+    overrides numbers by name, and ``truck`` ("rigid_frame", the default, or "three_piece") picks the
+    bogie model (the DOF count follows it)."""
     return dict(_core.tank_car_parameters(car, wheel_profile))
 
 
-def wheelset_stations(cars: int = 1, station: float = 50.0, car: dict[str, float] | None = None) -> np.ndarray:
+def wheelset_stations(cars: int = 1, station: float = 50.0, car: dict[str, float | str] | None = None) -> np.ndarray:
     """Track positions (arc length s, m) of every wheelset at t = 0, front to rear over all cars whose
     front tank centre is at ``station``: read off the train that ``rail_mbs::vehicle::build_train``
     builds, so it is the runs' own placement (car k's tank centre at ``station - k (2 coupler_reach +
@@ -59,7 +63,7 @@ def wheelset_stations(cars: int = 1, station: float = 50.0, car: dict[str, float
 
 
 def _irregularity(
-    irregularity: Irregularity | dict[str, Any] | None, cars: int, station: float, car: dict[str, float] | None
+    irregularity: Irregularity | dict[str, Any] | None, cars: int, station: float, car: dict[str, float | str] | None
 ) -> tuple[dict[str, Any] | None, Irregularity | None]:
     """The samples dict for the kernels and the :class:`railslosh.irregularity.Irregularity`
     (``None``, ``None`` without one), checked to be zero under the train at t = 0."""
@@ -138,7 +142,7 @@ def run(
     wheelset_lateral_offset: float = 0.0,
     coupler_stiffness: float | None = None,
     coupler_damping: float | None = None,
-    car: dict[str, float] | None = None,
+    car: dict[str, float | str] | None = None,
     progress: ProgressArg = None,
     stream: str | os.PathLike[str] | None = None,
     friction_map: Mapping[str, Any] | None = None,
@@ -250,7 +254,7 @@ def run_fluid(
     fill: float = 0.5,
     bulkheads: Sequence[tuple[float, float]] | None = None,
     wheel_profile: str = "s1002",
-    car: dict[str, float] | None = None,
+    car: dict[str, float | str] | None = None,
     progress: ProgressArg = None,
     stream: str | os.PathLike[str] | None = None,
     friction_map: Mapping[str, Any] | None = None,
@@ -339,7 +343,7 @@ def equivalent_model(
     fluid: Any = None,
     bulkheads: Sequence[tuple[float, float]] | None = None,
     slosh_axis: str = "longitudinal",
-    car: dict[str, float] | None = None,
+    car: dict[str, float | str] | None = None,
 ) -> dict[str, Any]:
     """The equivalent spring-mass / pendulum model of one car's liquid (``rail_mbs::vehicle::equivalent``):
     liquid ``mass``, ``depth``, ``depth_fraction``, ``lambda``, rest ``centroid`` (tank frame) and one
@@ -382,7 +386,7 @@ def run_equivalent(
     lading_mass: float = 0.0,
     lading_height: float = 0.0,
     wheel_profile: str = "s1002",
-    car: dict[str, float] | None = None,
+    car: dict[str, float | str] | None = None,
     progress: ProgressArg = None,
     stream: str | os.PathLike[str] | None = None,
     friction_map: Mapping[str, Any] | None = None,

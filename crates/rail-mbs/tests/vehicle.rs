@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use rail_mbs::mbs::Table;
 use rail_mbs::track::Track;
-use rail_mbs::vehicle::{BrakeScope, TankCarParams, TrainScenario, build_train, run_train};
+use rail_mbs::vehicle::{BrakeScope, TankCarParams, TrainScenario, TruckModel, build_train, run_train};
 
 fn tangent() -> Arc<Track> {
     Arc::new(Track::straight(3000.0).unwrap())
@@ -38,6 +38,18 @@ fn tank_car_and_train_have_the_documented_structure() {
     let (mb, _, couplers) = build_train(&two).unwrap();
     assert_eq!(mb.dof(), 136);
     assert_eq!(couplers.len(), 1);
+    // A three-piece truck: two side frames (6 DOF each) instead of one frame on its pin (1 DOF
+    // beyond the bolster), and the bolster in the centre bowl (1 DOF) instead of on springs (6).
+    let mut three = sc.clone();
+    three.car.truck = TruckModel::ThreePiece;
+    let (mb, cars, _) = build_train(&three).unwrap();
+    assert_eq!(mb.bodies().len(), 17);
+    assert_eq!(mb.dof(), 68 + 2 * (12 + 1 - 1 - 6));
+    let [left, right] = cars[0].frames[0];
+    assert_ne!(left, right);
+    assert_eq!(mb.bodies()[left.0].name, "car1/bogie1/side_frameL");
+    assert_eq!(TruckModel::from_name("three_piece").unwrap().name(), "three_piece");
+    assert!(TruckModel::from_name("bogie").unwrap_err().to_string().contains("truck"));
 }
 
 #[test]

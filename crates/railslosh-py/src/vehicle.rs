@@ -13,7 +13,7 @@ use rail_mbs::profile::aar1b_wheel_approx;
 use rail_mbs::track::{Track, TrackPoint};
 use rail_mbs::vehicle::{
     BrakeScope, EquivalentCargo, EquivalentModel, EquivalentTrainRecord, FluidCargo, FluidTrainRecord, LoadFilter,
-    Observer, SampleSink, SloshAxis, TankCarParams, TrainRecord, TrainScenario,
+    Observer, SampleSink, SloshAxis, TankCarParams, TrainRecord, TrainScenario, TruckModel,
     run_equivalent_train_streamed as rust_run_equivalent_train, run_fluid_train_streamed as rust_run_fluid_train,
     run_train_streamed as rust_run_train,
 };
@@ -73,8 +73,15 @@ fn car_params(overrides: Option<&Bound<'_, PyDict>>, wheel_profile: &str) -> PyR
     if let Some(d) = overrides {
         for (k, v) in d.iter() {
             let key: String = k.extract()?;
+            if key == "truck" {
+                let name: String =
+                    v.extract().map_err(|_| crate::to_py(invalid("car.truck", v, "'rigid_frame' or 'three_piece'")))?;
+                p.truck = TruckModel::from_name(&name)
+                    .map_err(|_| crate::to_py(invalid("car.truck", &name, "'rigid_frame' or 'three_piece'")))?;
+                continue;
+            }
             let Some(f) = FIELDS.iter().find(|f| f.0 == key) else {
-                let names: Vec<&str> = FIELDS.iter().map(|f| f.0).collect();
+                let names: Vec<&str> = FIELDS.iter().map(|f| f.0).chain(["truck"]).collect();
                 return Err(crate::to_py(invalid("car", &key, &format!("one of {names:?}"))));
             };
             let x: f64 = v.extract().map_err(|_| crate::to_py(invalid(&format!("car.{key}"), v, "a number")))?;

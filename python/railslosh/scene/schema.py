@@ -31,6 +31,9 @@ OILS = ("light", "medium", "heavy", "water", "custom")
 RHEOLOGIES = ("newtonian", "bingham", "herschel-bulkley", "oldroyd", "casson")
 """Values of ``[fluid] model`` (the rheology of a custom oil)."""
 WHEEL_PROFILES = ("s1002", "aar1b")
+#: Bogie models (rail_mbs::vehicle::TruckModel): seed 000's rigid frame, or a warp-capable
+#: three-piece freight truck.
+TRUCK_MODELS = ("rigid_frame", "three_piece")
 BRAKE_SCOPES = ("all", "front")
 STEPPERS = ("implicit", "explicit", "auto")
 """Values of ``[solver] stepper`` of slosh scenes."""
@@ -340,6 +343,12 @@ SCHEMA: dict[str, dict[str, dict[str, Field]]] = {
         },
         "car": {
             "wheel_profile": _choice(WHEEL_PROFILES, "s1002", "wheel profile"),
+            "truck": _choice(
+                TRUCK_MODELS,
+                "rigid_frame",
+                "bogie model: seed 000's rigid frame, or a three-piece truck whose side frames warp "
+                '(docs/user-guide.md, "Bogie model")',
+            ),
             "*": _value(
                 "a number",
                 "any key of vehicle.tank_car_parameters() but dof and total_mass: friction 0 to 1, stiffness and "

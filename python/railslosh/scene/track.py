@@ -237,7 +237,7 @@ def irregularity_spec(
     *,
     cars: int,
     station: float,
-    car: Mapping[str, float] | None,
+    car: Mapping[str, float | str] | None,
     speed: float,
     t_end: float,
 ) -> dict[str, Any]:

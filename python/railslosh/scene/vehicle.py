@@ -70,7 +70,7 @@ class Scene:
     brake_scope: str = "all"
     lading_mass: float = 0.0
     lading_height: float = 0.0
-    car: Mapping[str, float] = field(default_factory=dict)
+    car: Mapping[str, float | str] = field(default_factory=dict)
     wheel_profile: str = "s1002"
     name: str = ""
     """Title of the scene (``[scene] name``)."""
@@ -256,14 +256,17 @@ def _to_dict(sc: Scene) -> dict[str, Any]:
     return d
 
 
-def _car(doc: Mapping[str, Any]) -> tuple[dict[str, float], str]:
-    """``[car]``: the overridden parameters (checked by the model too) and the wheel profile."""
+def _car(doc: Mapping[str, Any]) -> tuple[dict[str, Any], str]:
+    """``[car]``: the overridden parameters (checked by the model too; ``truck`` a name, every
+    other one a number) and the wheel profile."""
     defaults = car_defaults()
     sec = Section("vehicle", "car", doc, extra=defaults)
     wheel_profile = sec.get("wheel_profile")
-    car = {}
+    car: dict[str, Any] = {}
     for k, v in sec.values.items():
-        if k != "wheel_profile":
+        if k == "truck":
+            car[k] = sec.get("truck")
+        elif k != "wheel_profile":
             limit, note = car_limit(k, defaults[k])
             car[k] = limit.check(v, f"car.{k}", note=note)
     if car or wheel_profile != "s1002":

@@ -52,6 +52,6 @@ pub use run::{
     stopped_by_observer,
 };
 pub use tank_car::{
-    BodyMass, CarBodies, CarPlacement, ContactParams, SuspensionParams, TANK_HEAD_DEPTH, TankCarParams, WheelLoad,
-    add_coupler, add_tank_car, wheel_loads,
+    BodyMass, CarBodies, CarPlacement, ContactParams, SuspensionParams, TANK_HEAD_DEPTH, TankCarParams, TruckModel,
+    WheelLoad, add_coupler, add_tank_car, wheel_loads,
 };

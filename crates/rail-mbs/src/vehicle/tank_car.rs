@@ -129,8 +129,13 @@ pub struct TankCarParams {
     /// Bolster. Default 911 kg, 509 / 25 / 511 kg·m² (mbsim-wagons Barber truck).
     pub bolster: BodyMass,
     /// Bogie frame (the two side frames as one body). Default 630 kg (mbsim-wagons
-    /// side-frame pair), inertia of two 2.5 m beams at ±1 m.
+    /// side-frame pair), inertia of two 2.5 m beams at ±1 m. With
+    /// [`TruckModel::ThreePiece`] each side frame is its own body with half this mass, at
+    /// ±`journal_half_span` ([`TankCarParams::side_frame`]).
     pub frame: BodyMass,
+    /// How the bogie is built: seed 000's rigid frame (default) or a warp-capable
+    /// three-piece freight truck ([`TruckModel`]).
+    pub truck: TruckModel,
     /// Each equalizer. Default 120 kg, 1.9 m long beam (assumed).
     pub equalizer: BodyMass,
     /// Lateral half-distance of the axle boxes / journal bearings, m. Default 1.0.
@@ -155,6 +160,50 @@ pub struct TankCarParams {
     pub coupler_reach: f64,
     /// Wheel/rail contact.
     pub contact: ContactParams,
+}
+
+/// How a bogie (truck) of [`add_tank_car`] is built. Both have the same masses, springs and
+/// dampers; they differ in what the two side frames can do.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum TruckModel {
+    /// Seed 000's bogie: both side frames are one rigid frame on the four axle boxes (primary
+    /// suspension), turning on a centre pin under the bolster, which carries the stub sill on
+    /// the secondary suspension. A twist of the track within the bogie (one wheel lower than
+    /// the plane of the other three) is taken by the stiff primary springs and moves wheel
+    /// load: about ±46 % of the static load per 1.7 mm (docs/validation.md, "Findings on
+    /// irregular track").
+    #[default]
+    RigidFrame,
+    /// Three-piece freight truck: a left and a right side frame, each on its own two axle
+    /// boxes (primary suspension, with the journal bearing's roll stiffness
+    /// `journal_tilt_stiffness` at each adapter), carry the bolster on the load springs (the
+    /// `secondary` parameters, one nest per side frame, at ±`journal_half_span`, preloaded by
+    /// the car body and the bolster); the bolster turns in the centre bowl (a revolute joint
+    /// about the vertical) under the stub sill. The side frames pitch independently, so the
+    /// truck warps: a twist within the bogie changes its wheel loads only through the load
+    /// springs. The load springs sit under the side frames (not at `secondary_half_span`),
+    /// so the car body's roll stiffness on its trucks is that of a three-piece truck,
+    /// (journal/secondary half span)² times the rigid frame's.
+    ThreePiece,
+}
+
+impl TruckModel {
+    /// The scene / Python name: `"rigid_frame"` or `"three_piece"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::RigidFrame => "rigid_frame",
+            Self::ThreePiece => "three_piece",
+        }
+    }
+
+    /// The model named `name` ([`TruckModel::name`]); the error names the field `truck`.
+    pub fn from_name(name: &str) -> Result<Self, AncfError> {
+        match name {
+            "rigid_frame" => Ok(Self::RigidFrame),
+            "three_piece" => Ok(Self::ThreePiece),
+            other => Err(invalid("truck", other, "'rigid_frame' or 'three_piece'")),
+        }
+    }
 }
 
 fn beam(mass: f64, length: f64) -> BodyMass {
@@ -206,6 +255,7 @@ impl TankCarParams {
             wheelset: BodyMass { mass: 1777.6, inertia: [1179.6, 138.0, 1179.6] },
             bolster: BodyMass { mass: 911.0, inertia: [509.0, 25.0, 511.0] },
             frame: BodyMass { mass: 630.0, inertia: [630.0, 328.0, 958.0] },
+            truck: TruckModel::RigidFrame,
             equalizer: beam(120.0, 1.9),
             journal_half_span: 1.0,
             secondary_half_span: 0.8,
@@ -217,6 +267,17 @@ impl TankCarParams {
             coupler_reach: 7.0,
             contact: ContactParams::standard()?,
         })
+    }
+
+    /// One side frame of a [`TruckModel::ThreePiece`] truck: half of [`TankCarParams::frame`],
+    /// its roll and yaw inertia about its own centre by the parallel-axis theorem (the pair's
+    /// side frames lie at ±`journal_half_span`), at least 1 % of its pitch inertia.
+    pub fn side_frame(&self) -> BodyMass {
+        let m = 0.5 * self.frame.mass;
+        let d2 = self.journal_half_span * self.journal_half_span;
+        let iy = 0.5 * self.frame.inertia[1];
+        let own = |i: f64| (0.5 * i - m * d2).max(0.01 * iy);
+        BodyMass { mass: m, inertia: [own(self.frame.inertia[0]), iy, own(self.frame.inertia[2])] }
     }
 
     /// Height of the tank body's centre of mass (its frame origin) above the tank axis, m:
@@ -323,8 +384,9 @@ pub struct CarBodies {
     pub stub_sills: [BodyId; 2],
     /// Bolsters (front, rear bogie).
     pub bolsters: [BodyId; 2],
-    /// Bogie frames.
-    pub frames: [BodyId; 2],
+    /// Bogie frames `[bogie][left, right]`: the rigid frame twice ([`TruckModel::RigidFrame`])
+    /// or the two side frames ([`TruckModel::ThreePiece`]).
+    pub frames: [[BodyId; 2]; 2],
     /// Equalizers `[bogie][left, right]`.
     pub equalizers: [[BodyId; 2]; 2],
     /// Wheelsets, front to rear.
@@ -529,7 +591,7 @@ pub fn add_tank_car(
     let sill_z = p.tank_axis_height - p.tank_radius;
     let mut stub_sills = [tank; 2];
     let mut bolsters = [tank; 2];
-    let mut frames = [tank; 2];
+    let mut frames = [[tank; 2]; 2];
     let mut equalizers = [[tank; 2]; 2];
     let mut wheelsets = [tank; 4];
     let mut contacts = [0; 4];
@@ -575,15 +637,28 @@ pub fn add_tank_car(
     };
     let mut brakes = Vec::new();
     if let Some(torque) = brake {
+        // The brake's reaction goes to the frame; on a three-piece truck half to each side frame
+        // (the brake beams are guided in both).
+        let split = match p.truck {
+            TruckModel::RigidFrame => 1,
+            TruckModel::ThreePiece => 2,
+        };
+        let share = Table { x: torque.x.clone(), y: torque.y.iter().map(|y| y / split as f64).collect() };
         for (k, ws) in wheelsets.iter().enumerate() {
-            brakes.push(mb.add_force(Box::new(BrakeTorque {
-                name: format!("{name}/brake{}", k + 1),
-                bodies: [Some(*ws), Some(frames[k / 2])],
-                axis: Vector3::y(),
-                torque: torque.clone(),
-                smoothing: 0.5,
-                speed_factor: None,
-            }))?);
+            for (side, frame) in frames[k / 2].iter().take(split).enumerate() {
+                brakes.push(mb.add_force(Box::new(BrakeTorque {
+                    name: if split == 1 {
+                        format!("{name}/brake{}", k + 1)
+                    } else {
+                        format!("{name}/brake{}{}", k + 1, if side == 0 { "L" } else { "R" })
+                    },
+                    bodies: [Some(*ws), Some(*frame)],
+                    axis: Vector3::y(),
+                    torque: if split == 1 { torque.clone() } else { share.clone() },
+                    smoothing: 0.5,
+                    speed_factor: None,
+                }))?);
+            }
         }
     }
     Ok(CarBodies {
@@ -620,9 +695,9 @@ struct CarFrame<'a> {
 }
 
 /// Bogie `b` (0 front, 1 rear) of [`add_tank_car`], centred at track station `sb`: its stub sill
-/// fixed to the tank, bolster, frame, equalizers and two wheelsets with their suspensions and
-/// wheel/rail contacts (written into `wheelsets` and `contacts` at 2b + w). Returns (stub sill,
-/// bolster, frame, equalizers).
+/// fixed to the tank, bolster, frame (or side frames, [`TruckModel`]), equalizers and two
+/// wheelsets with their suspensions and wheel/rail contacts (written into `wheelsets` and
+/// `contacts` at 2b + w). Returns (stub sill, bolster, frames `[left, right]`, equalizers).
 fn add_bogie(
     mb: &mut Multibody,
     car: &CarFrame,
@@ -630,7 +705,7 @@ fn add_bogie(
     sb: f64,
     wheelsets: &mut [BodyId; 4],
     contacts: &mut [usize; 4],
-) -> Result<(BodyId, BodyId, BodyId, [BodyId; 2]), AncfError> {
+) -> Result<(BodyId, BodyId, [BodyId; 2], [BodyId; 2]), AncfError> {
     let CarFrame { name, p, track, place, sill_z, tank, r0, per_bogie, per_axlebox, per_bearing, wheel_load, speed } =
         *car;
     let frame_sb = track.frame(sb);
@@ -646,23 +721,51 @@ fn add_bogie(
         axes,
     )?;
     let bolster = mb.add_body(place.body(format!("{bn}/bolster"), p.bolster, sb, 0.0, 0.6))?;
-    let frame = mb.add_body(place.body(format!("{bn}/frame"), p.frame, sb, 0.0, 0.45))?;
-    mb.add_joint(
-        &format!("{bn}/pin"),
-        JointKind::Revolute,
-        Some(bolster),
-        Some(frame),
-        frame_sb.to_global(&Vector3::new(0.0, 0.0, 0.55)),
-        axes,
-    )?;
-    for (k, side) in [(0usize, 1.0), (1, -1.0)] {
-        let at = frame_sb.to_global(&Vector3::new(0.0, side * p.secondary_half_span, 0.75));
-        let preload = Vector3::new(0.0, 0.0, 0.5 * per_bogie);
-        let bu = bushing(mb, format!("{bn}/secondary{k}"), bolster, sill, at, axes, &p.secondary, preload);
-        mb.add_force(Box::new(bu))?;
-    }
+    let sides = [(0usize, 1.0), (1, -1.0)];
+    let frames = match p.truck {
+        TruckModel::RigidFrame => {
+            let frame = mb.add_body(place.body(format!("{bn}/frame"), p.frame, sb, 0.0, 0.45))?;
+            mb.add_joint(
+                &format!("{bn}/pin"),
+                JointKind::Revolute,
+                Some(bolster),
+                Some(frame),
+                frame_sb.to_global(&Vector3::new(0.0, 0.0, 0.55)),
+                axes,
+            )?;
+            for (k, side) in sides {
+                let at = frame_sb.to_global(&Vector3::new(0.0, side * p.secondary_half_span, 0.75));
+                let preload = Vector3::new(0.0, 0.0, 0.5 * per_bogie);
+                let bu = bushing(mb, format!("{bn}/secondary{k}"), bolster, sill, at, axes, &p.secondary, preload);
+                mb.add_force(Box::new(bu))?;
+            }
+            [frame; 2]
+        }
+        TruckModel::ThreePiece => {
+            mb.add_joint(
+                &format!("{bn}/centre_bowl"),
+                JointKind::Revolute,
+                Some(sill),
+                Some(bolster),
+                frame_sb.to_global(&Vector3::new(0.0, 0.0, 0.75)),
+                axes,
+            )?;
+            let mut frames = [bolster; 2];
+            for (k, side) in sides {
+                let y = side * p.journal_half_span;
+                let lr = if k == 0 { "L" } else { "R" };
+                frames[k] = mb.add_body(place.body(format!("{bn}/side_frame{lr}"), p.side_frame(), sb, y, 0.45))?;
+                let at = frame_sb.to_global(&Vector3::new(0.0, y, 0.6));
+                let preload = Vector3::new(0.0, 0.0, 0.5 * (per_bogie + p.bolster.mass * mb.gravity.norm()));
+                let bu =
+                    bushing(mb, format!("{bn}/load_springs{k}"), frames[k], bolster, at, axes, &p.secondary, preload);
+                mb.add_force(Box::new(bu))?;
+            }
+            frames
+        }
+    };
     let mut eq = [tank; 2];
-    for (k, side) in [(0usize, 1.0), (1, -1.0)] {
+    for (k, side) in sides {
         eq[k] = mb.add_body(place.body(
             format!("{bn}/equalizer{}", if k == 0 { "L" } else { "R" }),
             p.equalizer,
@@ -681,10 +784,18 @@ fn add_bogie(
         let ws = mb.add_body(ws)?;
         let idx = 2 * b + w;
         wheelsets[idx] = ws;
-        for (k, side) in [(0usize, 1.0), (1, -1.0)] {
+        for (k, side) in sides {
             let at = fw.to_global(&Vector3::new(0.0, side * p.journal_half_span, z));
             let pre = Vector3::new(0.0, 0.0, -per_axlebox);
-            let bu = bushing(mb, format!("{bn}/primary{}{k}", w + 1), frame, ws, at, fw.rotation, &p.primary, pre);
+            let mut bu =
+                bushing(mb, format!("{bn}/primary{}{k}", w + 1), frames[k], ws, at, fw.rotation, &p.primary, pre);
+            if p.truck == TruckModel::ThreePiece {
+                // The side frame's pedestal roof on the bearing adapter holds it upright: its
+                // two axle boxes lie on one line, along which springs alone give no roll
+                // stiffness.
+                bu.rotational_stiffness = [p.journal_tilt_stiffness, 0.0, 0.0];
+                bu.free_axis = Some(1);
+            }
             mb.add_force(Box::new(bu))?;
             let pre = Vector3::new(0.0, 0.0, -per_bearing);
             let mut jb = bushing(mb, format!("{bn}/journal{}{k}", w + 1), eq[k], ws, at, fw.rotation, &p.journal, pre);
@@ -698,7 +809,7 @@ fn add_bogie(
             wheels: pair,
         })?;
     }
-    Ok((sill, bolster, frame, eq))
+    Ok((sill, bolster, frames, eq))
 }
 
 /// Joins the rear of `front` to the front of `rear` with a coupler (linear
