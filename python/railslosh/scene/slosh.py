@@ -59,8 +59,9 @@ class SloshScene:
     * ``"bump"``: ``shape = "half_round" | "trapezoid"`` of ``height`` (m) or ``height_in``, crossed at
       ``speed`` by a two-axle vehicle (``wheelbase`` m, default 3.9; ``wheel_radius`` m, default 0.53,
       rolling over a half-round bump) with a quarter-car suspension per axle
-      (``suspension_frequency`` Hz, default 2.0; ``suspension_damping`` ratio, default 0.3); the tank,
-      midway between the axles, heaves and pitches; a trapezoid has ``ramp_up``, ``top`` and
+      (``suspension_frequency`` Hz, default 2.0; ``suspension_damping`` ratio, default 0.3) whose massless
+      wheel leaves the road rather than pull on it (that axle then falls freely until the wheel lands);
+      the tank, midway between the axles, heaves and pitches; a trapezoid has ``ramp_up``, ``top`` and
       ``ramp_down`` lengths (m; defaults 4, 2 and 1 times the height: asymmetric, steep exit);
     * ``"pulse"``: ``axis``, ``acceleration`` (m/s^2), ``t0``, ``t1``, ``ramp`` (s);
     * ``"samples"``: ``x``, ``y``, ``z`` = ``[[t, a], ...]`` piecewise-linear accelerations.
