@@ -6,6 +6,7 @@ import copy
 import dataclasses
 import json
 import math
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -517,3 +518,31 @@ def test_wheel_loads_on_irregular_track_have_no_single_sample_drops():
     assert q.min() > 30e3, f"a wheel load fell to {q.min():.0f} N"
     jump = np.abs(np.diff(q, axis=0)).max()
     assert jump < 8e3, f"largest 1 ms change of a wheel load {jump:.0f} N"
+
+
+def test_a_generated_fra_track_is_checked_against_its_class_limits():
+    """49 CFR 213.53 (gauge at least 4 ft 8 in; at most 4 ft 9 3/4 in on class 2-3, 4 ft 9 1/2 in on
+    class 4-5) and 213.63 (cross-level on tangent within 1 3/4 in on class 3, 1 in on class 5): a
+    Gaussian realization of a class's spectrum is unbounded, and the seed-1 class 3 track of
+    ``irregular_fra3_60kmh`` narrows to -15.1 mm by 105 m (the leading wheelset of a run with all
+    four channels jams there at 60 km/h, docs/validation.md "Three-piece trucks on irregular
+    track"). The run record says so, and a vehicle run that goes there warns."""
+    inch = 0.0254
+    assert irregularity.FRA_GAUGE_LIMITS[3] == pytest.approx((-0.5 * inch, 1.25 * inch))
+    assert irregularity.FRA_GAUGE_LIMITS[5] == pytest.approx((-0.5 * inch, 1.0 * inch))
+    assert irregularity.FRA_CROSS_LEVEL_LIMITS[3] == pytest.approx(1.75 * inch)
+    irr = irregularity.generate("fra", track_class=3, length=1000.0, start=58.0, taper=5.0, seed=1)
+    lim = irr.summary()["class_limits"]
+    assert not lim["gauge"]["within"] and lim["gauge"]["min"] < -0.5 * inch
+    assert lim["cross_level"]["within"]
+    assert irregularity.class_limit_exceedances(irr, 90.0) == []
+    (words,) = irregularity.class_limit_exceedances(irr, 105.0)
+    assert words.startswith("gauge -15.1 to") and "-12.7 to +31.8 mm (49 CFR 213.53)" in words
+    # only the channels a run carries, and only FRA classes 1-5
+    assert irregularity.class_limit_exceedances(irr.with_channels(["vertical"])) == []
+    assert irregularity.generate("erri_low", length=200.0, start=58.0, seed=1).class_limits() == {}
+    with pytest.warns(RuntimeWarning, match=r"FRA class 3 track exceeds its class's limits where this run goes"):
+        vehicle._irregularity(irr, 1, 50.0, None, 60.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        vehicle._irregularity(irr, 1, 50.0, None, 20.0)

@@ -71,12 +71,15 @@ from typing import Any
 import numpy as np
 
 from railslosh import _core
+from railslosh.constants import INCH
 from railslosh.limits import invalid, suggest, unknown
 
 __all__ = [
     "CHANNELS",
     "CLEARANCE",
     "DEFECTS",
+    "FRA_CROSS_LEVEL_LIMITS",
+    "FRA_GAUGE_LIMITS",
     "MAX_SAMPLES",
     "MEANINGS",
     "PSD_TOLERANCE",
@@ -86,6 +89,7 @@ __all__ = [
     "WELCH_NPERSEG",
     "Irregularity",
     "band_ratios",
+    "class_limit_exceedances",
     "file_sha256",
     "from_spec",
     "generate",
@@ -124,6 +128,19 @@ MAX_SAMPLES = 2_000_000
 """Most samples per channel of a generated or perfect track (``length / step``; 500 km at 0.25 m)."""
 WELCH_NPERSEG = 1024
 """Default samples per Welch segment of :func:`welch_psd` (256 m at the 0.25 m default spacing)."""
+
+FRA_GAUGE_LIMITS: dict[int, tuple[float, float]] = {
+    1: (-0.5 * INCH, 1.5 * INCH),
+    2: (-0.5 * INCH, 1.25 * INCH),
+    3: (-0.5 * INCH, 1.25 * INCH),
+    4: (-0.5 * INCH, 1.0 * INCH),
+    5: (-0.5 * INCH, 1.0 * INCH),
+}
+"""FRA Track Safety Standards, 49 CFR 213.53: the gauge of class 1–5 track is at least 4 ft 8 in and
+at most 4 ft 10 in (class 1), 4 ft 9 3/4 in (2 and 3), 4 ft 9 1/2 in (4 and 5); here as the
+``gauge`` channel's range about the nominal 4 ft 8 1/2 in (m). Class 6 (Subpart G) is not listed."""
+FRA_CROSS_LEVEL_LIMITS: dict[int, float] = {1: 3.0 * INCH, 2: 2.0 * INCH, 3: 1.75 * INCH, 4: 1.25 * INCH, 5: 1.0 * INCH}
+"""49 CFR 213.63: the largest deviation from zero cross-level on tangent track of class 1–5 (m)."""
 
 _COLUMNS = ("distance", *CHANNELS)
 _SCALE = {"m": 0, "mm": 3}  # decimal places a value in these units is shifted by from metres
@@ -266,7 +283,31 @@ class Irregularity:
             "step": self.step,
             "samples": self.samples,
             "rms": self.rms(),
+            **({"class_limits": limits} if (limits := self.class_limits()) else {}),
         }
+
+    def class_limits(self, until: float | None = None) -> dict[str, dict[str, Any]]:
+        """For a generated FRA track of class 1–5 (``spec`` ``kind = "fra"``), its ``gauge`` and
+        ``cross_level`` extremes (over the samples up to distance ``until``, m; default all)
+        against the class's limits (:data:`FRA_GAUGE_LIMITS`, :data:`FRA_CROSS_LEVEL_LIMITS`; m):
+        ``{channel: {"min", "max", "limits", "within"}}``; empty for other tracks. The Gaussian
+        realization of a class's spectrum is not bounded: it can exceed the limits that define the
+        class."""
+        track_class = self.spec.get("class")
+        if self.spec.get("kind") != "fra" or track_class not in FRA_GAUGE_LIMITS:
+            return {}
+        n = (
+            self.samples
+            if until is None
+            else int(np.clip(np.floor((until - self.start) / self.step) + 1, 1, self.samples))
+        )
+        cross = FRA_CROSS_LEVEL_LIMITS[track_class]
+        out: dict[str, dict[str, Any]] = {}
+        for channel, (lo, hi) in (("gauge", FRA_GAUGE_LIMITS[track_class]), ("cross_level", (-cross, cross))):
+            x = getattr(self, channel)[:n]
+            xmin, xmax = float(x.min()), float(x.max())
+            out[channel] = {"min": xmin, "max": xmax, "limits": [lo, hi], "within": lo <= xmin and xmax <= hi}
+        return out
 
     def with_channels(self, channels: Iterable[str]) -> Irregularity:
         """The same irregularity with only ``channels`` kept (the others zero); ``spec`` says which."""
@@ -294,6 +335,21 @@ class Irregularity:
 
 
 # --- generation, defects, specs ---------------------------------------------------------------------
+
+
+def class_limit_exceedances(irr: Irregularity, until: float | None = None) -> list[str]:
+    """The FRA class limits a generated track exceeds up to distance ``until`` (m; default its end;
+    :meth:`Irregularity.class_limits`), each in words; empty when it keeps them (or is no FRA class
+    1–5 track)."""
+    out = []
+    for channel, c in irr.class_limits(until).items():
+        if not c["within"]:
+            lo, hi = c["limits"]
+            out.append(
+                f"{channel} {1e3 * c['min']:+.1f} to {1e3 * c['max']:+.1f} mm against "
+                f"{1e3 * lo:+.1f} to {1e3 * hi:+.1f} mm ({'49 CFR 213.53' if channel == 'gauge' else '49 CFR 213.63'})"
+            )
+    return out
 
 
 def _rename(exc: ValueError, names: Mapping[str, str]) -> ValueError:

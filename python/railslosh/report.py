@@ -377,6 +377,17 @@ def _irregularity(ds: Any) -> list[tuple[str, str]]:
     for c, v in (spec.get("rms") or {}).items():
         if float(v) > 0:  # channels not drawn are zero
             rows.append((f"RMS {c.replace('_', ' ')}", f"{num(float(v) * 1e3, 3)} mm"))
+    limits = spec.get("class_limits")
+    for c, v in (json.loads(limits) if isinstance(limits, str) else limits or {}).items():
+        if v["min"] != 0.0 or v["max"] != 0.0:
+            lo, hi = v["limits"]
+            rows.append(
+                (
+                    f"{c.replace('_', ' ')} against FRA limits",
+                    f"{num(v['min'] * 1e3, 3)} to {num(v['max'] * 1e3, 3)} mm, limits {num(lo * 1e3, 3)} to "
+                    f"{num(hi * 1e3, 3)} mm: {'within' if v['within'] else 'EXCEEDED'} (whole realization)",
+                )
+            )
     return rows
 
 

@@ -18,14 +18,17 @@ left; coupler forces are positive in tension.
 
 from __future__ import annotations
 
+import math
 import numbers
 import os
+import warnings
 from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
 
 from railslosh import _core, limits
+from railslosh import irregularity as irregularity_module
 from railslosh.irregularity import CLEARANCE, Irregularity
 from railslosh.progress import ProgressArg
 from railslosh.progress import callback as progress_callback
@@ -63,10 +66,17 @@ def wheelset_stations(cars: int = 1, station: float = 50.0, car: dict[str, float
 
 
 def _irregularity(
-    irregularity: Irregularity | dict[str, Any] | None, cars: int, station: float, car: dict[str, float | str] | None
+    irregularity: Irregularity | dict[str, Any] | None,
+    cars: int,
+    station: float,
+    car: dict[str, float | str] | None,
+    travel: Any = None,
 ) -> tuple[dict[str, Any] | None, Irregularity | None]:
     """The samples dict for the kernels and the :class:`railslosh.irregularity.Irregularity`
-    (``None``, ``None`` without one), checked to be zero under the train at t = 0."""
+    (``None``, ``None`` without one), checked to be zero under the train at t = 0. A generated FRA
+    track that exceeds its class's gauge or cross-level limits within ``travel`` (m, the initial
+    speed times the run's time) ahead of the leading wheelset is run as given, with a warning
+    (:func:`railslosh.irregularity.class_limit_exceedances`)."""
     if irregularity is None:
         return None, None
     irr = irregularity if isinstance(irregularity, Irregularity) else Irregularity.from_dict(irregularity)
@@ -85,7 +95,24 @@ def _irregularity(
             f"wheelset at {lead:.6g} m; it is irregular {where}: start the irregular section (and its taper) "
             f"at {lead + CLEARANCE:.6g} m or beyond",
         )
+    if isinstance(travel, numbers.Real) and math.isfinite(travel):
+        exceeded = irregularity_module.class_limit_exceedances(irr, lead + abs(float(travel)))
+        if exceeded:
+            warnings.warn(
+                f"the generated FRA class {irr.spec.get('class')} track exceeds its class's limits where "
+                f"this run goes (up to {lead + abs(float(travel)):.6g} m): {'; '.join(exceeded)}. It runs as "
+                "given; a real track of that class would be repaired there",
+                RuntimeWarning,
+                stacklevel=3,
+            )
     return irr.to_dict(), irr
+
+
+def _travel(speed: Any, t_end: Any) -> float | None:
+    """How far the train goes at its initial ``speed`` (m/s) in ``t_end`` (s), m; ``None`` for input
+    the kernels will refuse."""
+    ok = all(isinstance(x, numbers.Real) and not isinstance(x, bool) for x in (speed, t_end))
+    return float(speed) * float(t_end) if ok else None
 
 
 def _table(track: Any) -> list[list[float]]:
@@ -188,7 +215,7 @@ def run(
     ``.results`` up to the failure) when the run stops early.
     """
     drive_speed, times, torques = _drive_and_brake(drive, speed, brake)
-    samples, irr = _irregularity(irregularity, cars, station, car)
+    samples, irr = _irregularity(irregularity, cars, station, car, _travel(speed, t_end))
     with progress_callback(progress, "vehicle run") as on_progress:
         res = dict(
             _core.run_train(
@@ -289,7 +316,7 @@ def run_fluid(
     wall_damping_ratio = limits.check("wall_damping_ratio", wall_damping_ratio)
     wall_adhesion = limits.check("wall_adhesion", wall_adhesion)
     drive_speed, times, torques = _drive_and_brake(drive, speed, brake)
-    samples, irr = _irregularity(irregularity, cars, station, car)
+    samples, irr = _irregularity(irregularity, cars, station, car, _travel(speed, t_end))
     with progress_callback(progress, "vehicle run") as on_progress:
         res = dict(
             _core.run_fluid_train(
@@ -404,7 +431,7 @@ def run_equivalent(
         raise ValueError(f"invalid `slosh_axis` = {slosh_axis!r}: expected one of {', '.join(SLOSH_AXES)}")
     fill = limits.check("fill", fill)
     drive_speed, times, torques = _drive_and_brake(drive, speed, brake)
-    samples, irr = _irregularity(irregularity, cars, station, car)
+    samples, irr = _irregularity(irregularity, cars, station, car, _travel(speed, t_end))
     with progress_callback(progress, "vehicle run") as on_progress:
         res = dict(
             _core.run_equivalent_train(
