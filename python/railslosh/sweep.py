@@ -252,7 +252,9 @@ def run_sweep(
                 cluster.close()
     # one hypercube: every point on the union of the time grids
     expanded = [ds.expand_dims({n: [pt[n]] for n in names}) for ds, pt in zip(out, points, strict=True)]
-    combined = xr.combine_by_coords(expanded, data_vars="all", combine_attrs="drop_conflicts", join="outer")
+    combined = xr.combine_by_coords(
+        expanded, data_vars="all", combine_attrs="drop_conflicts", join="outer", compat="no_conflicts"
+    )
     combined.attrs["sweep_dims"] = ",".join(names)
     for n in names:
         combined[n].attrs["long_name"] = f"sweep parameter {ALIASES.get(n, n)}"
