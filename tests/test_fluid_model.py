@@ -41,6 +41,26 @@ def _decide(doc):
     return fluid_model.decide(scene.load_scene(doc))
 
 
+def test_irregular_track_with_alignment_or_cross_level_is_ancf():
+    """Rule 3 (docs/user-guide.md, "Bogie model": on FRA class 5 track with all four channels the
+    liquid moves the wheel-unloading, L/V and load-transfer extremes by -47 % to +84 % against rigid
+    lading): a lateral channel or a twist defect picks ANCF; the vertical profile alone does not."""
+    tangent = {"preset": "tangent", "length": 1500.0}
+    irr = {"kind": "fra", "class": 5, "seed": 1, "start": 58.0, "taper": 5.0}
+    base = _with(BRAKING, brake=None, train={"cars": 1, "station": 50.0})
+    for channels, model in ((["vertical"], "rigid"), (["vertical", "cross_level"], "ancf"), (["alignment"], "ancf")):
+        doc = _with(base, track={**tangent, "irregularities": {**irr, "channels": channels}})
+        c = _decide(doc)
+        assert c.model == model, (channels, c.reason)
+        if model == "ancf":
+            assert c.reason.startswith("irregular track with") and "84 %" in c.reason
+    twist = {"kind": "perfect", "defects": [{"type": "twist", "start": 70.0, "base": 3.0, "cross_level": 0.01}]}
+    assert _decide(_with(base, track={**tangent, "irregularities": twist})).model == "ancf"
+    # a requested model is kept
+    doc = _with(base, track={**tangent, "irregularities": irr}, fluid={"slosh_model": "rigid"})
+    assert _decide(doc).model == "rigid"
+
+
 def test_no_excitation_is_rigid():
     c = _decide(_with(BRAKING, brake=None))
     assert (c.model, c.axis, c.accel_x, c.accel_y) == ("rigid", None, 0.0, 0.0)

@@ -12,20 +12,25 @@ A vehicle scene with liquid cargo (a ``[fluid]`` section) can run its liquid as
 1. a model other than ``"auto"`` is used as requested;
 2. ``"ancf"`` if the outputs need the fluid's shape (``[outputs] snapshot_every > 0``: mesh
    snapshots for ParaView);
-3. the excitations are estimated: longitudinal, the deceleration of the designed or tabulated brake
+3. ``"ancf"`` on irregular track whose alignment or cross-level is not zero (a generated spectrum
+   with those channels, a file, or a twist defect): it excites the liquid laterally and in roll
+   over a broad band, and on FRA class 5 track the liquid moves the largest wheel unloading, L/V
+   and load transfer ratio by up to −47 % and +84 % against rigid lading (docs/user-guide.md,
+   "Bogie model"); the vertical profile alone leaves the rule below;
+4. the excitations are estimated: longitudinal, the deceleration of the designed or tabulated brake
    torque ``a_x = n_braked 4 T_max / (r_wheel m_car cars)`` (0 for a train at rest); lateral, the
    largest unbalanced acceleration ``|v^2 kappa - g e / B|`` (``B`` = 1.5 m cant base) on the track
    the train covers during the run, at the train's (or driven) speed. An axis is excited when its
    estimate exceeds :data:`EXCITATION_THRESHOLD` (0.1 m/s^2);
-4. ``"rigid"`` if neither axis is excited (no brake, tangent track, or curving within 0.1 m/s^2 of
+5. ``"rigid"`` if neither axis is excited (no brake, tangent track, or curving within 0.1 m/s^2 of
    the balance speed);
-5. ``"ancf"`` if both are (braking in a curve: the equivalent model represents one axis only);
-6. ``"ancf"`` if the linear free-surface rise ``DYNAMIC_FACTOR (L/2) a / g`` exceeds
+6. ``"ancf"`` if both are (braking in a curve: the equivalent model represents one axis only);
+7. ``"ancf"`` if the linear free-surface rise ``DYNAMIC_FACTOR (L/2) a / g`` exceeds
    :data:`RISE_LIMIT_FRACTION` of ``min(h, 2R - h)`` (the surface would reach the bottom or the
    top of the tank: nonlinear sloshing). ``L`` is the longest compartment's equivalent length
    (longitudinal) or the free-surface width ``2 w`` (lateral); ``DYNAMIC_FACTOR`` = 2 covers the
    dynamic overshoot of a suddenly applied acceleration;
-7. otherwise ``"pendulum"`` on the excited axis.
+8. otherwise ``"pendulum"`` on the excited axis.
 
 The choice and its reason are recorded in the results (xarray attributes ``fluid_model`` and
 ``fluid_model_reason``) and printed by ``railslosh run``.
@@ -107,6 +112,17 @@ def _lateral_acceleration(sc: Any, params: dict[str, float]) -> float:
     return float(np.max(np.abs(speed**2 * kappa - G * e / CANT_BASE)))
 
 
+def _lateral_irregularity(sc: Any) -> list[str]:
+    """The channels among alignment and cross-level that the scene's track irregularity has
+    (not zero somewhere)."""
+    if getattr(sc, "irregularity", None) is None:
+        return []
+    irr = sc.track_irregularity()
+    if irr is None:
+        return []
+    return [c for c in ("alignment", "cross_level") if np.any(getattr(irr, c) != 0.0)]
+
+
 def decide(sc: Any) -> FluidModelChoice:
     """The fluid model of a vehicle scene (:class:`railslosh.scene.Scene`) by the rule of the module
     docs. A scene without ``[fluid]`` is ``"rigid"`` (its lading, if any, is rigid)."""
@@ -142,6 +158,14 @@ def decide(sc: Any) -> FluidModelChoice:
         return choice(requested, f'requested: [fluid] slosh_model = "{requested}"{tail}; {est}')
     if sc.outputs.snapshot_every > 0:
         return choice("ancf", "the outputs need the fluid shape (outputs.snapshot_every > 0)")
+    lateral = _lateral_irregularity(sc)
+    if lateral:
+        return choice(
+            "ancf",
+            f"irregular track with {' and '.join(c.replace('_', '-') for c in lateral)}: the liquid moves the "
+            "wheel-unloading, L/V and load-transfer extremes by up to 84 % against rigid lading "
+            f'(docs/user-guide.md, "Bogie model"); {est}',
+        )
     if not excited:
         return choice("rigid", f"no axis excited above {EXCITATION_THRESHOLD:g} m/s^2 ({est})")
     if len(excited) == 2:
