@@ -114,8 +114,9 @@ def _python_cases() -> dict[str, Case]:
     from railslosh.fmu import FMU_CASES
     from railslosh.irregularity import VALIDATION_CASES as IRREGULARITY_CASES
     from railslosh.swri_cases import SWRI_CASES
+    from railslosh.truck_cases import TRUCK_CASES
 
-    cases = {**PY_CASES, **FMU_CASES, **SWRI_CASES, **IRREGULARITY_CASES}
+    cases = {**PY_CASES, **FMU_CASES, **SWRI_CASES, **IRREGULARITY_CASES, **TRUCK_CASES}
     return {name: Case(name, desc, fn) for name, (desc, fn) in cases.items()}
 
 
