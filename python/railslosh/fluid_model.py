@@ -115,8 +115,6 @@ def _lateral_acceleration(sc: Any, params: dict[str, float]) -> float:
 def _lateral_irregularity(sc: Any) -> list[str]:
     """The channels among alignment and cross-level that the scene's track irregularity has
     (not zero somewhere)."""
-    if getattr(sc, "irregularity", None) is None:
-        return []
     irr = sc.track_irregularity()
     if irr is None:
         return []

@@ -377,8 +377,7 @@ def _irregularity(ds: Any) -> list[tuple[str, str]]:
     for c, v in (spec.get("rms") or {}).items():
         if float(v) > 0:  # channels not drawn are zero
             rows.append((f"RMS {c.replace('_', ' ')}", f"{num(float(v) * 1e3, 3)} mm"))
-    limits = spec.get("class_limits")
-    for c, v in (json.loads(limits) if isinstance(limits, str) else limits or {}).items():
+    for c, v in (spec.get("class_limits") or {}).items():
         if v["min"] != 0.0 or v["max"] != 0.0:
             lo, hi = v["limits"]
             rows.append(

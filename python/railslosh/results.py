@@ -151,8 +151,8 @@ def _irregularity(irr: Any) -> tuple[dict[str, Any], dict[str, Any], dict[str, A
     """The variables, coordinate and global attributes of a run's track irregularity
     (:class:`railslosh.irregularity.Irregularity`): ``irregularity_<channel>`` on the ``distance``
     dimension (m), and its :meth:`~railslosh.irregularity.Irregularity.summary` as
-    ``irregularity_<key>`` attributes (``rms`` as ``irregularity_rms_<channel>``, ``defects`` as
-    JSON text)."""
+    ``irregularity_<key>`` attributes (``rms`` as ``irregularity_rms_<channel>``, ``defects`` and
+    ``class_limits`` as JSON text)."""
     from railslosh.irregularity import CHANNELS, MEANINGS, Irregularity
 
     if not isinstance(irr, Irregularity):
@@ -193,7 +193,8 @@ def irregularity_spec(ds: Any) -> dict[str, Any] | None:
     """The track irregularity a results Dataset records (:func:`to_dataset`), back as a dict:
     ``kind``, ``class``, ``seed``, ``wavelengths``, ``taper``, ``start``, ``length``, ``step``,
     ``channels``, ``file``, ``units``, ``sha256``, ``defects``, ``first``/``last`` distance,
-    ``samples`` and ``rms`` (per channel) as far as the run had them; ``None`` without one."""
+    ``samples``, ``rms`` (per channel) and ``class_limits`` as far as the run had them; ``None``
+    without one."""
     a = ds.attrs
     if "irregularity_kind" not in a:
         return None
@@ -205,7 +206,7 @@ def irregularity_spec(ds: Any) -> dict[str, Any] | None:
         key = k[len("irregularity_") :]
         if key.startswith("rms_"):
             rms[key[4:]] = float(v)
-        elif key == "defects":
+        elif key in ("defects", "class_limits"):
             out[key] = json.loads(v)
         elif key == "channels":
             out[key] = [c for c in str(v).split(",") if c]

@@ -29,8 +29,6 @@ import numpy as np
 
 from railslosh.records import record
 
-#: Distance of the leading wheelset ahead of the front tank centre at t = 0 (station 50 m), m.
-_LEAD = 50.0 + 4.5 + 1.829 / 2
 #: Lateral distance of the two wheels' contact points, m (the estimate's lever arm).
 _CONTACT_SPAN = 1.5
 
@@ -40,8 +38,9 @@ def twist_run(truck: str, twist: dict[str, Any], speed: float, t_end: float, ste
     wheelset (m); raises :class:`railslosh.slosh.SimulationError` when the run stops."""
     from railslosh import irregularity, vehicle
 
-    twist = {**twist, "start": _LEAD + twist["start"]}
-    irr = irregularity.with_defects([twist], start=0.0, end=_LEAD + 60.0, step=0.05)
+    lead = float(vehicle.wheelset_stations(cars=1, station=50.0)[0])
+    twist = {**twist, "start": lead + twist["start"]}
+    irr = irregularity.with_defects([twist], start=0.0, end=lead + 60.0, step=0.05)
     rows = [[0, 0, 0, 0, 0.025, -0.025], [3000, 0, 0, 0, 0.025, -0.025]]
     return vehicle.run(
         rows,

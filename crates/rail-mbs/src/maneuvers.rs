@@ -419,17 +419,19 @@ fn bump_response(
             }
             for (ax, &o) in st.iter_mut().zip(&offsets) {
                 if ax.flying {
-                    // z̈ = −g exactly; the wheel's extension by RK4
-                    let f = |z: f64, zd: f64, uw: f64| if zeta > 0.0 { extension(z, zd, uw) } else { 0.0 };
+                    // z̈ = −g exactly; the wheel's extension by RK4 (algebraic without damping)
                     let (z, zd, uw) = (ax.z, ax.zd, ax.uw);
-                    let k1 = f(z, zd, uw);
-                    let (zm, zdm) = (z + 0.5 * hs * zd - 0.125 * g * hs * hs, zd - 0.5 * g * hs);
-                    let k2 = f(zm, zdm, uw + 0.5 * hs * k1);
-                    let k3 = f(zm, zdm, uw + 0.5 * hs * k2);
                     let (z1, zd1) = (z + hs * zd - 0.5 * g * hs * hs, zd - g * hs);
-                    let k4 = f(z1, zd1, uw + hs * k3);
-                    let uw1 =
-                        if zeta > 0.0 { uw + hs / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4) } else { z1 - g / (wn * wn) };
+                    let uw1 = if zeta > 0.0 {
+                        let (zm, zdm) = (z + 0.5 * hs * zd - 0.125 * g * hs * hs, zd - 0.5 * g * hs);
+                        let k1 = extension(z, zd, uw);
+                        let k2 = extension(zm, zdm, uw + 0.5 * hs * k1);
+                        let k3 = extension(zm, zdm, uw + 0.5 * hs * k2);
+                        let k4 = extension(z1, zd1, uw + hs * k3);
+                        uw + hs / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+                    } else {
+                        z1 - g / (wn * wn)
+                    };
                     *ax = Axle { z: z1, zd: zd1, uw: uw1, flying: true };
                 } else {
                     let (z, v) = (ax.z, ax.zd);

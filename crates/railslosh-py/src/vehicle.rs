@@ -74,10 +74,9 @@ fn car_params(overrides: Option<&Bound<'_, PyDict>>, wheel_profile: &str) -> PyR
         for (k, v) in d.iter() {
             let key: String = k.extract()?;
             if key == "truck" {
-                let name: String =
-                    v.extract().map_err(|_| crate::to_py(invalid("car.truck", v, "'rigid_frame' or 'three_piece'")))?;
-                p.truck = TruckModel::from_name(&name)
-                    .map_err(|_| crate::to_py(invalid("car.truck", &name, "'rigid_frame' or 'three_piece'")))?;
+                let bad = || crate::to_py(invalid("car.truck", &v, "'rigid_frame' or 'three_piece'"));
+                let name: String = v.extract().map_err(|_| bad())?;
+                p.truck = TruckModel::from_name(&name).map_err(|_| bad())?;
                 continue;
             }
             let Some(f) = FIELDS.iter().find(|f| f.0 == key) else {

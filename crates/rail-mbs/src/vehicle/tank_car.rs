@@ -639,22 +639,19 @@ pub fn add_tank_car(
     if let Some(torque) = brake {
         // The brake's reaction goes to the frame; on a three-piece truck half to each side frame
         // (the brake beams are guided in both).
-        let split = match p.truck {
-            TruckModel::RigidFrame => 1,
-            TruckModel::ThreePiece => 2,
+        let reactions: &[&str] = match p.truck {
+            TruckModel::RigidFrame => &[""],
+            TruckModel::ThreePiece => &["L", "R"],
         };
-        let share = Table { x: torque.x.clone(), y: torque.y.iter().map(|y| y / split as f64).collect() };
+        let share = reactions.len() as f64;
+        let torque = Table { x: torque.x.clone(), y: torque.y.iter().map(|y| y / share).collect() };
         for (k, ws) in wheelsets.iter().enumerate() {
-            for (side, frame) in frames[k / 2].iter().take(split).enumerate() {
+            for (side, frame) in reactions.iter().zip(frames[k / 2]) {
                 brakes.push(mb.add_force(Box::new(BrakeTorque {
-                    name: if split == 1 {
-                        format!("{name}/brake{}", k + 1)
-                    } else {
-                        format!("{name}/brake{}{}", k + 1, if side == 0 { "L" } else { "R" })
-                    },
-                    bodies: [Some(*ws), Some(*frame)],
+                    name: format!("{name}/brake{}{side}", k + 1),
+                    bodies: [Some(*ws), Some(frame)],
                     axis: Vector3::y(),
-                    torque: if split == 1 { torque.clone() } else { share.clone() },
+                    torque: torque.clone(),
                     smoothing: 0.5,
                     speed_factor: None,
                 }))?);
