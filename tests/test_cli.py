@@ -96,6 +96,22 @@ def test_run_plot_report_as_a_user_does(tmp_path):
     assert cli.main(["report", str(out)]) == 0 and (out / "report.html").is_file()
 
 
+def test_a_run_with_overrides_is_titled_with_them(tmp_path, capsys):
+    """Plots, report and results.nc of ``--set fluid.oil=heavy`` on a light-crude scene do not say
+    "light crude" alone."""
+    from railslosh import results
+
+    scene_file = str(EXAMPLES / "two_car_ecp_braking_rigid.toml")
+    args = ["run", scene_file, "-q", "--t-end", "0.02"]
+    assert cli.main([*args, "-o", str(tmp_path / "a"), "--set", "train.speed_kmh=30"]) == 0
+    assert cli.main([*args, "-o", str(tmp_path / "b"), "--set", "scene.name=slow"]) == 0
+    assert cli.main([*args, "-o", str(tmp_path / "c")]) == 0
+    capsys.readouterr()
+    titles = [results.load(tmp_path / d / "results.nc").attrs["title"] for d in "abc"]
+    name = titles[2] or "two_car_ecp_braking_rigid"  # a scene without [scene] name: its file's stem
+    assert titles == [f"{name} [train.speed_kmh=30]", "slow", titles[2]]
+
+
 def test_run_set_overrides_and_errors(tmp_path, capsys):
     scene_file = str(EXAMPLES / "two_car_ecp_braking_rigid.toml")
     r = run_cli("run", scene_file, "-o", str(tmp_path), "--set", "train.speed_kmh=500", "-q")

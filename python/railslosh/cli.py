@@ -9,6 +9,7 @@ time > 0 s and ≤ 600 s``), and exit status 2; never a traceback.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import math
 import os
@@ -174,6 +175,10 @@ def _cmd_run(args: argparse.Namespace) -> int:
     if args.t_end is not None:
         over.setdefault("solver" if sc.kind == "slosh" else "train", {})["t_end"] = args.t_end
         sc = scene.load_scene(doc, over)
+    if args.set and "name" not in over.get("scene", {}):
+        # the title of the plots, the report and results.nc says what was changed: "ECP braking, light
+        # crude" run with --set fluid.oil=heavy is not the light crude
+        sc = dataclasses.replace(sc, name=f"{sc.name or Path(args.scene).stem} [{', '.join(args.set)}]")
     out = _out_dir(args.out, Path("out") / Path(args.scene).stem)
     print(f"railslosh run: {sc.name or Path(args.scene).stem} ({sc.kind}, t_end = {sc.t_end:g} s) -> {out}")
     if sc.kind != "slosh":
