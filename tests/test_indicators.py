@@ -124,6 +124,39 @@ def test_unevenly_sampled_accelerations_are_resampled():
     assert indicators.iso2631_weighted_rms(t, acc, "z") == pytest.approx(0.967 * 0.5 / math.sqrt(2), rel=2e-2)
 
 
+# --- the load low-pass ---------------------------------------------------------------------------
+
+
+def test_the_load_low_pass_keeps_the_slosh_band_and_removes_penalty_ringing():
+    # unevenly spaced times, as an adaptive run records them (0.5 ms +- 30 %)
+    rng = np.random.default_rng(3)
+    t = np.arange(8001) * 5e-4
+    t[1:-1] += rng.uniform(-1.5e-4, 1.5e-4, t.size - 2)
+    slosh = 100.0 * np.sin(2 * np.pi * 1.4 * t)
+    ringing = 40.0 * np.sin(2 * np.pi * 45.0 * t)
+    grid, y = indicators.low_pass(t, slosh + ringing)
+    assert grid[1] - grid[0] == pytest.approx(1.0 / (50 * indicators.LOAD_CUTOFF), rel=1e-3)
+    inner = (grid > 0.5) & (grid < 3.5)
+    # forward-backward 4th-order Butterworth: gain 1/(1 + (f/fc)^8) at 1.4 Hz and 45 Hz
+    expected = 100.0 / (1 + (1.4 / 20) ** 8) * np.sin(2 * np.pi * 1.4 * grid)
+    assert np.abs(y - expected)[inner].max() < 40.0 / (1 + (45 / 20) ** 8) + 0.05
+    # the gain of the pair at the cut-off is 1/2
+    grid, y = indicators.low_pass(t, np.sin(2 * np.pi * 20.0 * t))
+    assert np.abs(y[inner]).max() == pytest.approx(0.5, rel=0.02)
+
+
+def test_the_load_low_pass_has_zero_phase_and_filters_each_component():
+    t = np.linspace(0.0, 1.0, 2001)
+    pulse = np.exp(-(((t - 0.4) / 0.03) ** 2))
+    grid, y = indicators.low_pass(t, np.column_stack([pulse, -2.0 * pulse]))
+    assert y.shape == (grid.size, 2)
+    assert grid[np.argmax(y[:, 0])] == pytest.approx(0.4, abs=1e-3)
+    np.testing.assert_allclose(y[:, 1], -2.0 * y[:, 0], rtol=1e-12, atol=1e-12)
+    # a constant load passes unchanged
+    grid, y = indicators.low_pass(t, np.full(t.size, 137.3))
+    np.testing.assert_allclose(y, 137.3, rtol=1e-9)
+
+
 # --- derailment and roll-over --------------------------------------------------------------------
 
 
@@ -189,6 +222,10 @@ def test_the_50_ms_rule_keeps_exceedances_of_50_ms_or_longer():
         (lambda: indicators.wheel_unloading([1.0], 0.0), "q0"),
         (lambda: indicators.exceedances([0.0, 0.01, 0.02], [0.0, 1.0, 0.0], 0.5, min_duration=-1.0), "min_duration"),
         (lambda: indicators.load_transfer_ratio(np.ones((3, 3))), "wheel_vertical"),
+        (lambda: indicators.low_pass([0.0, 0.1, 0.2], [1.0, 2.0, 3.0], cutoff=0.0), "cutoff"),
+        (lambda: indicators.low_pass([0.0, 0.1, 0.2], [1.0, 2.0, 3.0], order=9), "order"),
+        (lambda: indicators.low_pass([0.0, 0.1, 0.1], [1.0, 2.0, 3.0]), "t"),
+        (lambda: indicators.low_pass([0.0, 0.1, 0.2], [1.0, 2.0]), "x"),
     ],
 )
 def test_bad_input_is_a_value_error_in_the_one_form(call, field):

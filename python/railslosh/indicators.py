@@ -36,6 +36,7 @@ __all__ = [
     "ISO2631_WEIGHTINGS",
     "L_OVER_V_LIMIT",
     "L_OVER_V_STANDARD",
+    "LOAD_CUTOFF",
     "MIN_DURATION",
     "NADAL_FRICTION",
     "SPERLING_BAND",
@@ -51,6 +52,7 @@ __all__ = [
     "level_crossings",
     "load_spectrum",
     "load_transfer_ratio",
+    "low_pass",
     "nadal_limit",
     "rainflow_cycles",
     "sperling_weighting",
@@ -90,6 +92,14 @@ and 75°: 1.13 + 0.5 ≈ 1.6)."""
 MIN_DURATION = 0.05
 """s: AAR Chapter XI's duration rule: a wheel L/V, axle-sum L/V or wheel-load criterion counts as
 exceeded only when the quantity stays beyond its limit for 50 ms or longer (:func:`exceedances`)."""
+
+LOAD_CUTOFF = 20.0
+"""Hz: cut-off of the low-pass through which force peaks are read (:func:`low_pass`): EN 14363:2016
+(UIC 518) filters the vertical wheel–rail force Q at 20 Hz before taking its peak (its 99.85 %
+percentile). In railslosh it also keeps the penalty liquid's heave and compression modes out of
+a fluid-load peak: they ring at 20–60 Hz on a step of the tank's acceleration, and their overshoot
+does not depend on the penalty stiffnesses (docs/validation.md, "Peak loads through EN 14363's
+20 Hz low-pass")."""
 
 SPERLING_BAND = (0.5, 40.0)
 """Hz: the frequencies summed in Sperling's ride index (:func:`sperling_wz`); Sperling's
@@ -163,6 +173,38 @@ def _uniform(t: Any, acc: Any) -> tuple[float, np.ndarray]:
     n = int(round((tt[-1] - tt[0]) / step)) + 1
     grid = np.linspace(tt[0], tt[-1], n)
     return float(grid[1] - grid[0]), np.interp(grid, tt, a)
+
+
+def low_pass(t: Any, x: Any, cutoff: float = LOAD_CUTOFF, order: int = 4) -> tuple[np.ndarray, np.ndarray]:
+    """``(grid, y)``: the record ``x`` (one value per time, or one row of components per time)
+    taken at times ``t`` (s, strictly increasing, not necessarily uniform), linearly interpolated
+    onto a uniform grid of ``1/(50 cutoff)`` s and passed forward and backward through a Butterworth
+    low-pass of ``order`` at ``cutoff`` Hz (``scipy.signal.sosfiltfilt``: zero phase, so a peak
+    stays where it happened; the pair's gain is the square of the filter's, 0.5 at ``cutoff``).
+    The default is EN 14363's 20 Hz for wheel–rail forces (:data:`LOAD_CUTOFF`); the peak of a
+    load is ``np.abs(y).max()``, or the largest norm of its filtered components."""
+    from scipy import signal
+
+    fc = _positive("cutoff", cutoff, "frequency (Hz)")
+    if isinstance(order, bool) or not isinstance(order, int | np.integer) or not 1 <= order <= 8:
+        raise invalid("order", order, "an integer from 1 to 8")
+    tt = _series("t", t)
+    xx = np.asarray(x, dtype=float)
+    if xx.ndim not in (1, 2) or xx.shape[0] != tt.size:
+        raise invalid("x", f"array of shape {xx.shape}", f"{tt.size} values or rows, one per time")
+    if tt.size < 2 or not np.isfinite(tt).all() or not (np.diff(tt) > 0).all():
+        raise invalid("t", "array", "at least 2 finite, strictly increasing times (s)")
+    if not np.isfinite(xx).all():
+        raise invalid("x", "array with NaN or inf", "finite values")
+    n = int(math.ceil((tt[-1] - tt[0]) * 50.0 * fc)) + 1
+    grid = np.linspace(tt[0], tt[-1], max(n, 2))
+    cols = xx.reshape(tt.size, -1)
+    y = np.column_stack([np.interp(grid, tt, c) for c in cols.T])
+    sos = signal.butter(int(order), fc, fs=1.0 / (grid[1] - grid[0]), output="sos")
+    pad = min(3 * (2 * sos.shape[0] + 1), grid.size - 1)
+    if grid.size > 3:
+        y = signal.sosfiltfilt(sos, y, axis=0, padlen=pad)
+    return grid, (y[:, 0] if xx.ndim == 1 else y)
 
 
 # --- ride ----------------------------------------------------------------------------------------

@@ -473,15 +473,29 @@ def _split(da: Any) -> list[tuple[str | None, Any]]:
     return [(None, da)]
 
 
-def extreme(da: Any, *, mode: str = "abs", after: float = 0.0) -> Peak | None:
+def extreme(da: Any, *, mode: str = "abs", after: float = 0.0, cutoff: float | None = None) -> Peak | None:
     """The largest ``|value|`` (``mode="abs"``), largest (``"max"``) or smallest (``"min"``) value
     of a DataArray with a ``time`` dimension over ``t >= after``, as a :class:`Peak`; None when
-    nothing finite is there. A ``component`` coordinate of one component is kept in ``component``."""
+    nothing finite is there. A ``component`` coordinate of one component is kept in ``component``.
+    With ``cutoff`` (Hz) the values at ``t >= after`` first pass through
+    :func:`railslosh.indicators.low_pass` at that cut-off (e.g.
+    :data:`railslosh.indicators.LOAD_CUTOFF`, EN 14363's 20 Hz for forces); the time is then that of
+    the filter's grid."""
     if mode not in ("abs", "max", "min"):
         raise ValueError(f"invalid `mode` = {mode!r}: expected 'abs', 'max' or 'min'")
     da = da.transpose("time", ...)
     t = np.asarray(da["time"].values, dtype=float)
-    v = np.asarray(da.values, dtype=float)[t >= after - 1e-12]
+    keep = t >= after - 1e-12
+    t, v = t[keep], np.asarray(da.values, dtype=float)[keep]
+    if cutoff is not None:
+        # only the samples after `after` are filtered: the settling phase's spike stays out
+        from railslosh import indicators
+
+        finite = np.isfinite(v.reshape(t.size, -1)).all(axis=1)
+        if finite.sum() < 2:
+            return None
+        t, filtered = indicators.low_pass(t[finite], v.reshape(t.size, -1)[finite], cutoff)
+        v = filtered.reshape((t.size, *v.shape[1:]))
     if v.size == 0 or not np.isfinite(v).any():
         return None
     key = {"abs": np.abs(v), "max": v, "min": -v}[mode]
@@ -491,7 +505,7 @@ def extreme(da: Any, *, mode: str = "abs", after: float = 0.0) -> Peak | None:
     for d, i in zip(da.dims[1:], idx[1:], strict=True):
         where[d] = da[d].values[i].item() if d in da.coords else int(i)
     comp = str(da["component"].values.item()) if "component" in da.coords and da["component"].ndim == 0 else None
-    time = float(t[t >= after - 1e-12][idx[0]])
+    time = float(t[idx[0]])
     return Peak(str(da.name), comp, float(v.flat[flat]), time, where, da.attrs.get("units", ""), float(after))
 
 
