@@ -144,3 +144,27 @@ def test_figures_are_drawn_in_the_package_style(rigid, tmp_path):
     }
     with pytest.raises(ValueError, match="invalid `stem`"):
         plots.figure(rigid, "nope")
+
+
+def test_liquid_loads_recorded_at_every_step_are_also_drawn_through_the_20_hz_low_pass():
+    """A slosh load with 45 Hz penalty ringing: the raw line is drawn faint, the EN 14363 20 Hz
+    low-pass over it, each with its legend entry; coarsely recorded runs (vehicle runs at 50 Hz)
+    draw the one line."""
+    t = np.linspace(0.0, 2.0, 2001)
+    f = np.zeros((t.size, 3))
+    f[:, 1] = 40.0 * np.sin(2 * np.pi * 1.4 * t) + 10.0 * np.sin(2 * np.pi * 45.0 * t)
+    f[:, 2] = -140.0
+    ds = results.to_dataset({"t": t, "force_tank": f})
+    fig = plots.figure(ds, "slosh_force")
+    lateral = [a for a in fig.axes if a.get_ylabel().startswith("Lateral")][0]
+    raw, smooth = lateral.get_lines()
+    assert raw.get_label().endswith(", raw") and raw.get_alpha() == pytest.approx(0.3)
+    assert smooth.get_label().endswith("20 Hz low-pass (EN 14363)")
+    assert [x.get_text() for x in lateral.get_legend().get_texts()] == [raw.get_label(), smooth.get_label()]
+    x, y = np.asarray(smooth.get_xdata()), np.asarray(smooth.get_ydata())
+    inner = (x > 0.3) & (x < 1.7)
+    assert np.abs(y - 40.0 * np.sin(2 * np.pi * 1.4 * x))[inner].max() < 0.1
+    # recorded every 20 ms (a vehicle run's record_every): nothing above 20 Hz to remove, one line
+    coarse = results.to_dataset({"t": t[::20], "force_tank": f[::20]})
+    lateral = [a for a in plots.figure(coarse, "slosh_force").axes if a.get_ylabel().startswith("Lateral")][0]
+    assert [ln.get_label() for ln in lateral.get_lines()] == ["Liquid force on the tank"]

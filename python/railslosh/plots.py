@@ -24,7 +24,9 @@ import numpy as np
 from railslosh.indicators import (
     FLANGE_ANGLE,
     L_OVER_V_LIMIT,
+    LOAD_CUTOFF,
     UNLOADING_LIMIT,
+    low_pass,
     nadal_limit,
 )
 from railslosh.indicators import L_OVER_V_STANDARD as _L_OVER_V_SOURCE
@@ -116,6 +118,10 @@ _RESOLUTION = {
     "volume": 1e-6,
     "count": 1.0,
 }
+
+# liquid loads drawn also through EN 14363's 20 Hz low-pass (indicators.low_pass) when recorded
+# finely enough to carry content above it: the raw line faint, the filtered line over it
+_LOW_PASSED = frozenset(("force_tank", "moment_tank", "fluid_force_tank"))
 
 _AXES = {"x": "Longitudinal", "y": "Lateral", "z": "Vertical"}
 _ROTATIONS = {"x": "Roll", "y": "Pitch", "z": "Yaw"}
@@ -319,9 +325,18 @@ def _draw(fig: Any, ds: Any, spec: tuple[str, str, tuple[str, ...], str]) -> Non
         name = str(da.name)
         unit, f = display_unit(name, da.values if kind == "variable" else values, da.attrs.get("units", ""))
         ys = []
-        for text, s, style in _series(da.transpose("time", ...), per_car):
+        finite = np.isfinite(t)
+        filtered = name in _LOW_PASSED and t.size > 8 and np.median(np.diff(t)) <= 0.2 / LOAD_CUTOFF
+        for k_line, (text, s, style) in enumerate(_series(da.transpose("time", ...), per_car)):
             y = np.asarray(s.values, dtype=float) * f
-            ax.plot(t, y, label=text, **style)
+            ok = finite & np.isfinite(y)
+            if filtered and ok.sum() > 8:
+                style = {"color": f"C{k_line}", **style}
+                ax.plot(t, y, alpha=0.3, lw=0.8, **{**style, "label": f"{text}, raw"})
+                grid, yf = low_pass(t[ok], y[ok])
+                ax.plot(grid, yf, **{**style, "label": f"{text}, {LOAD_CUTOFF:g} Hz low-pass (EN 14363)"})
+            else:
+                ax.plot(t, y, label=text, **style)
             ys.append(y)
         refs = []
         for value, text, ls in limits(ds, name):
