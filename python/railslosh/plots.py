@@ -326,7 +326,7 @@ def _draw(fig: Any, ds: Any, spec: tuple[str, str, tuple[str, ...], str]) -> Non
         unit, f = display_unit(name, da.values if kind == "variable" else values, da.attrs.get("units", ""))
         ys = []
         finite = np.isfinite(t)
-        filtered = name in _LOW_PASSED and t.size > 8 and np.median(np.diff(t)) <= 0.2 / LOAD_CUTOFF
+        filtered = name in _LOW_PASSED and t.size > 8 and np.median(np.diff(t)) <= 0.2 / LOAD_CUTOFF * (1 + 1e-9)
         for k_line, (text, s, style) in enumerate(_series(da.transpose("time", ...), per_car)):
             y = np.asarray(s.values, dtype=float) * f
             ok = finite & np.isfinite(y)
