@@ -18,39 +18,37 @@ import pathlib
 
 import numpy as np
 
-from railslosh import fluids, indicators, scene, slosh
+from railslosh import scene, slosh
+from railslosh.swri_cases import PEAK_AFTER, peak_loads
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 
 
 def peaks(sc: scene.SloshScene, penalty_factor: float = 1.0) -> dict:
+    (mesh, fluid, tank, motion), kw = sc.run_args()
     if penalty_factor != 1.0:
         # the scene's own penalty (railslosh.scene.SloshScene.run_args), scaled
-        k = fluids.default_bulk_penalty(sc.fluid.density(), sc.depth()) * max(1.0, sc.peak_load_factor())
-        custom = {**sc.fluid.custom, "bulk_penalty": k * penalty_factor}
+        custom = {**sc.fluid.custom, "bulk_penalty": fluid.bulk_penalty * penalty_factor}
         sc = dataclasses.replace(sc, fluid=dataclasses.replace(sc.fluid, custom=custom))
-    args, kw = sc.run_args()
-    res = slosh.run(*args, **kw)
-    t, force = np.asarray(res["t"]), np.asarray(res["force_tank"])
-    raw = np.linalg.norm(force, axis=1)
-    grid, filtered = indicators.low_pass(t, force)
-    lp = np.linalg.norm(filtered, axis=1)
-    i = np.argmax(np.where(t > 0.2, raw, -1.0))
-    j = np.argmax(np.where(grid > 0.2, lp, -1.0))
+        (mesh, fluid, tank, motion), kw = sc.run_args()
+    res = slosh.run(mesh, fluid, tank, motion, **kw)
+    p = peak_loads(res)  # as railslosh validate swri-maneuvers reads them
     # the ringing: the strongest frequency above 20 Hz of |F| less its centred 20 ms moving average,
     # over 0.2-0.6 s (the front wheel meets the bump at 0.2 s)
-    tu = np.arange(0.2, 0.6, 2e-4)
+    t = np.asarray(res["t"])
+    raw = np.linalg.norm(np.asarray(res["force_tank"]), axis=1)
+    tu = np.arange(PEAK_AFTER, PEAK_AFTER + 0.4, 2e-4)
     fu = np.interp(tu, t, raw)
-    wide = np.interp(np.arange(0.19, 0.61, 2e-4), t, raw)
+    wide = np.interp(np.arange(PEAK_AFTER - 0.01, PEAK_AFTER + 0.41, 2e-4), t, raw)
     avg = np.convolve(wide, np.ones(100) / 100, mode="same")[50 : 50 + tu.size]
     spec = np.abs(np.fft.rfft((fu - avg) * np.hanning(tu.size)))
     freq = np.fft.rfftfreq(tu.size, 2e-4)
     ring = freq[freq > 20.0][np.argmax(spec[freq > 20.0])]
     return {
-        "raw_peak_N": round(float(raw[i]), 1),
-        "raw_peak_t": round(float(t[i]), 4),
-        "lowpass_peak_N": round(float(lp[j]), 1),
-        "lowpass_peak_t": round(float(grid[j]), 3),
+        "raw_peak_N": round(p.raw, 1),
+        "raw_peak_t": round(p.raw_time, 4),
+        "lowpass_peak_N": round(p.filtered, 1),
+        "lowpass_peak_t": round(p.filtered_time, 3),
         "ringing_Hz": round(float(ring), 1),
         "steps": int(t.size),
     }
