@@ -118,7 +118,12 @@ class Scene:
     def track_irregularity(self) -> Irregularity | None:
         """The :class:`railslosh.irregularity.Irregularity` of :meth:`irregularity_spec` (``None`` on
         perfect track): generated (a fraction of a second for a few hundred metres; the cost grows
-        with the length squared) or read from its file."""
+        with the length squared) or read from its file, once per scene (the fluid-model rule and
+        the run both ask for it; a changed scene, ``dataclasses.replace``, makes its own)."""
+        return self._track_irregularity
+
+    @functools.cached_property
+    def _track_irregularity(self) -> Irregularity | None:
         spec = self.irregularity_spec()
         return None if spec is None else from_spec(spec)
 
