@@ -187,3 +187,18 @@ def test_kernel_messages_are_in_the_one_form():
     # a car the kernels reject (in range alone, longer than the truck centres) names the scene field
     msg = _message({"track": {"preset": "tangent"}, "car": {"wheelbase": 15.0}})
     assert msg == "invalid `car.wheelbase` = 15: expected below truck_centers"
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        (lambda: rs.vehicle.run([[0.0] * 6, [3000.0] + [0.0] * 5], t_end="abc"), "invalid `t_end` = 'abc': "),
+        (lambda: rs.vehicle.run([[0.0] * 6, [3000.0] + [0.0] * 5], cars="two"), "invalid `cars` = 'two': "),
+        (lambda: _core.default_bulk_penalty(density="heavy", depth=1.0), "invalid `density` = 'heavy': "),
+    ],
+)
+def test_a_wrongly_typed_argument_of_a_compiled_function_is_named_in_the_message(call, message):
+    # PyO3 names the argument only in an exception note, which str(error) and one-line CLI errors drop
+    with pytest.raises(TypeError) as info:
+        call()
+    assert str(info.value).startswith(message), str(info.value)

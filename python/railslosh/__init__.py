@@ -5,7 +5,7 @@ analysis and the ``railslosh`` command-line tool. Units are SI throughout; frame
 conventions are defined in ``docs/frames.md``.
 """
 
-from railslosh import constants, fluids, irregularity, mesh, rail, scene, slosh, vehicle
+from railslosh import _core, constants, fluids, irregularity, limits, mesh, rail, scene, slosh, vehicle
 from railslosh._core import (
     Fluid,
     FluidBody,
@@ -14,6 +14,9 @@ from railslosh._core import (
     __version__,
 )
 from railslosh.body import mass_matrix
+
+# a wrongly typed argument of a compiled function names the argument (PyO3 names it in a note only)
+limits.name_native_arguments(_core)
 
 __all__ = [
     "Fluid",

@@ -16,13 +16,26 @@ functions taking the same parameter (:func:`railslosh.mesh.cylinder_tank`,
 from __future__ import annotations
 
 import difflib
+import functools
 import math
 import numbers
-from collections.abc import Iterable
+import re
+import types
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["FILL", "PARAMETERS", "Limit", "check", "invalid", "missing", "suggest", "unknown"]
+__all__ = [
+    "FILL",
+    "PARAMETERS",
+    "Limit",
+    "check",
+    "invalid",
+    "missing",
+    "name_native_arguments",
+    "suggest",
+    "unknown",
+]
 
 _MAX_SHOWN = 100  # characters of a value quoted in a message
 
@@ -128,3 +141,40 @@ def check(name: str, value: Any, field: str | None = None) -> Any:
     """Checks ``value`` against ``PARAMETERS[name]``; ``field`` names it in the error (default
     ``name``). Returns the value as a float."""
     return PARAMETERS[name].check(value, field or name)
+
+
+_NOTE = re.compile(r"while processing '([^']+)'")
+
+
+def _native_argument(error: TypeError) -> str | None:
+    """The argument that a compiled function's ``TypeError`` is about: PyO3 names it only in a
+    note (``while processing 't_end'``), which ``str(error)`` leaves out."""
+    for note in getattr(error, "__notes__", ()):
+        m = _NOTE.fullmatch(note)
+        if m:
+            return m.group(1)
+    return None
+
+
+def _named(fn: Callable[..., Any]) -> Callable[..., Any]:
+    @functools.wraps(fn)
+    def call(*args: Any, **kwargs: Any) -> Any:
+        try:
+            return fn(*args, **kwargs)
+        except TypeError as e:
+            field = _native_argument(e)
+            if field is None:
+                raise
+            shown = f" = {_show(kwargs[field])}" if field in kwargs else ""
+            raise TypeError(f"invalid `{field}`{shown}: {e}") from e
+
+    return call
+
+
+def name_native_arguments(module: types.ModuleType) -> None:
+    """Wraps every function of the compiled module ``module`` (``railslosh._core``) in place so
+    that an argument of the wrong type raises ``TypeError: invalid `t_end` = 'abc': must be real
+    number, not str`` instead of PyO3's message without the argument's name. Idempotent."""
+    for name, obj in vars(module).items():
+        if isinstance(obj, types.BuiltinFunctionType) and not name.startswith("_"):
+            setattr(module, name, _named(obj))
