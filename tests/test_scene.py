@@ -293,10 +293,11 @@ def test_every_paper_scenario_has_an_example_with_its_parameters(stem):
         assert sc.fluid.fill == 0.5
         if stem.startswith("crude_ecp_"):
             # issue 16: the ECP examples run the paper's 48-element mesh, with the largest step
-            # that resolves the identical-brake coupler force (railslosh-cases studies::ECP_STEP,
-            # ECP_STEP_VISCOUS for the medium and heavy crudes)
+            # that resolves the identical-brake coupler force (rail_mbs::defaults::ECP_STEP,
+            # ECP_STEP_VISCOUS for the medium and heavy crudes), chosen from the oil
             assert sc.fluid.counts == (6, 4, 2)
-            assert sc.step == (1e-3 if sc.fluid.oil in ("medium", "heavy") else 2e-3)
+            assert sc.step is None
+            assert sc.largest_step("ancf")[0] == (1e-3 if sc.fluid.oil in ("medium", "heavy") else 2e-3)
         else:
             assert sc.fluid.counts[0] * sc.fluid.counts[1] * sc.fluid.counts[2] <= 12
         if "oil" in want:
@@ -727,3 +728,25 @@ def test_track_friction_reaches_the_runs_and_bad_tables_name_the_field():
         )
     with pytest.raises(ValueError, match=r"friction_map"):
         railslosh.vehicle.run(sc.track_rows, **{**kw, "friction_map": {"mu": 0.3}})
+
+
+def test_a_braked_ancf_scene_without_a_step_takes_its_oils_converged_step():
+    """The light ECP scene gives no [train] step: the run takes ECP's converged step for its oil
+    (2 ms light, 1 ms medium and heavy), so an override or a sweep over the oil changes the step
+    with it; conventional braking takes 4 ms; a step the scene gives wins; other runs and models
+    keep the default."""
+    path = ROOT / "examples" / "scenes" / "crude_ecp_braking_light.toml"
+    light = scene.load_scene(path)
+    assert light.largest_step("ancf") == (2e-3, "ECP braking of light (railslosh._core.braking_step)")
+    for oil, want in (("medium", 1e-3), ("heavy", 1e-3), ("water", 2e-3)):
+        sc = scene.load_scene(path, overrides={"fluid": {"oil": oil}})
+        assert sc.largest_step("ancf")[0] == want
+        assert sc.fluid_kwargs()["step"] == want
+        assert sc.to_dict()["train"].get("step") is None  # still chosen, also after a round trip
+    conventional = scene.load_scene(path, overrides={"brake": {"scope": "front"}})
+    assert conventional.fluid_kwargs()["step"] == 4e-3
+    # the other liquid models, and a step the scene gives
+    assert light.rigid_kwargs()["step"] == light.equivalent_kwargs("longitudinal")["step"] == 1e-3
+    given = scene.load_scene(path, overrides={"train": {"step": 5e-4}, "fluid": {"oil": "heavy"}})
+    assert given.largest_step("ancf") == (5e-4, "train.step") and given.fluid_kwargs()["step"] == 5e-4
+    assert scene.scene_from_dict(given.to_dict()).step == 5e-4

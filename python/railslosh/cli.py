@@ -223,8 +223,9 @@ def _cmd_run(args: argparse.Namespace) -> int:
         "error": res.get("error"),
         "margins": res.get("margins"),
     }
-    # the model the run used (run_scene records it, also on a failed run)
-    summary |= {k: res[k] for k in ("fluid_model", "fluid_model_reason", "stepper", "stepper_reason") if k in res}
+    # the model and largest step the run used (run_scene records them, also on a failed run)
+    keys = ("fluid_model", "fluid_model_reason", "step", "step_reason", "stepper", "stepper_reason")
+    summary |= {k: res[k] for k in keys if k in res}
     if res.get("irregularity") is not None:  # the track irregularity: where it came from, its RMS per channel
         summary["irregularity"] = res["irregularity"].summary()
     (out / "run.json").write_text(json.dumps(summary, indent=1, default=str), encoding="utf-8")

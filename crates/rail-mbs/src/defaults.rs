@@ -10,7 +10,7 @@ pub use ancf_core::constants::GRAVITY;
 
 use crate::integrator::{AdaptiveParams, HhtParams, StepControl};
 use crate::mbs::Table;
-use crate::vehicle::TankCarParams;
+use crate::vehicle::{BrakeScope, TankCarParams};
 
 /// HHT settings of slosh runs: α = −0.3 (numerical damping of the penalty and contact
 /// modes), tolerances scaled to accelerations of order g, adaptive steps (h is the
@@ -151,6 +151,36 @@ impl Oil {
 
 /// Settling time before the brakes apply, s.
 pub const SETTLE: f64 = 0.5;
+
+/// Largest time step of the conventional-braking runs (the front car braked) and of the
+/// shipped conventional-braking scenes, s: their coupler force, the brake difference between
+/// the cars (tens of kN), changes by less than 0.01 % from 4 to 2 ms
+/// (`coupler-force-convergence`, `railslosh_cases`).
+pub const BRAKING_STEP: f64 = 4e-3;
+
+/// Largest time step of the ECP runs (every car braked) with light crude or water and of the
+/// shipped light-crude ECP scenes, s. With identical brakes the coupler force is a few tens of
+/// newtons riding on ±50 kN liquid loads, and at 4 ms it is not resolved in time: on the 4×4×2
+/// mesh over 6 s its RMS is 39.2 / 34.9 / 34.5 N at 4 / 2 / 1 ms (12 % then 1.1 %), and tighter
+/// Newton tolerances (1e-7 against 1e-4) move it by no more than the step does (docs/validation.md,
+/// "coupler-force-convergence").
+pub const ECP_STEP: f64 = 2e-3;
+
+/// Largest time step of the ECP runs with the medium and heavy crudes (and of their scenes), s:
+/// their coupler force converges more slowly in the step. On 4×4×2 over 6 s its RMS at
+/// 2 / 1 / 0.5 ms is 29.8 / 28.4 / 27.9 N (medium) and 40.6 / 37.5 / 36.7 N (heavy): 2 ms is
+/// 6.8 % and 10.6 % from the 0.5 ms figure, 1 ms 1.8 % and 2.2 %.
+pub const ECP_STEP_VISCOUS: f64 = 1e-3;
+
+/// The largest time step of a braking run with brake `scope` and liquid `oil` ([`ECP_STEP`],
+/// [`ECP_STEP_VISCOUS`] or [`BRAKING_STEP`]).
+pub fn braking_step(scope: BrakeScope, oil: Oil) -> f64 {
+    match (scope, oil) {
+        (BrakeScope::FrontCar, _) => BRAKING_STEP,
+        (BrakeScope::AllCars, Oil::Medium | Oil::Heavy) => ECP_STEP_VISCOUS,
+        (BrakeScope::AllCars, _) => ECP_STEP,
+    }
+}
 
 /// Brake torque per wheelset `T₀(1 − e^{−(t−t_s)/τ})` that slows a car of total mass
 /// `mass` from `v0` to `v1` in `duration` (rigid estimate, spin inertia included).

@@ -266,12 +266,16 @@ fn record_dict<'py>(py: Python<'py>, r: &TrainRecord) -> PyResult<Bound<'py, PyD
 }
 
 /// Brake table and scope from the Python arguments.
+fn brake_scope_of(scope: &str) -> PyResult<BrakeScope> {
+    match scope {
+        "all" => Ok(BrakeScope::AllCars),
+        "front" => Ok(BrakeScope::FrontCar),
+        other => Err(crate::to_py(invalid("brake_scope", other, "'all' or 'front'"))),
+    }
+}
+
 fn brake_of(times: Option<Vec<f64>>, torques: Option<Vec<f64>>, scope: &str) -> PyResult<Option<(Table, BrakeScope)>> {
-    let scope = match scope {
-        "all" => BrakeScope::AllCars,
-        "front" => BrakeScope::FrontCar,
-        other => return Err(crate::to_py(invalid("brake_scope", other, "'all' or 'front'"))),
-    };
+    let scope = brake_scope_of(scope)?;
     match (times, torques) {
         (Some(t), Some(m)) => Ok(Some((Table::new("brake_times/brake_torques", t, m).map_err(crate::to_py)?, scope))),
         (None, None) => Ok(None),
@@ -384,6 +388,15 @@ fn open_stream(
 
 fn oil_of(name: &str) -> PyResult<Oil> {
     Oil::from_name(name).map_err(crate::to_py)
+}
+
+/// The largest time step of an ANCF braking run with brake scope `brake_scope` (`"all"`: ECP,
+/// `"front"`: conventional) and liquid `oil`, s (`rail_mbs::defaults::braking_step`: 2 ms for ECP
+/// with light crude or water, 1 ms with medium or heavy crude, 4 ms for conventional braking;
+/// the step at which each run's coupler force is converged, docs/validation.md).
+#[pyfunction]
+pub fn braking_step(brake_scope: &str, oil: &str) -> PyResult<f64> {
+    Ok(rail_mbs::defaults::braking_step(brake_scope_of(brake_scope)?, oil_of(oil)?))
 }
 
 fn fluid_record_dict<'py>(py: Python<'py>, r: &FluidTrainRecord) -> PyResult<Bound<'py, PyDict>> {
@@ -716,5 +729,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(equivalent_model, m)?)?;
     m.add_function(wrap_pyfunction!(equivalent_lambda, m)?)?;
     m.add_function(wrap_pyfunction!(hat_mean_resample, m)?)?;
+    m.add_function(wrap_pyfunction!(braking_step, m)?)?;
     Ok(())
 }

@@ -26,7 +26,9 @@ def run_scene(
     ``progress(t, t_end, steps, newton_iterations, rejected_steps)`` is called during the run (about
     every 0.5 s of wall time); if it raises, the run stops and the exception propagates.
     Vehicle scenes with liquid cargo run the fluid model of :func:`railslosh.fluid_model.decide`
-    (``[fluid] slosh_model``); every vehicle result carries ``fluid_model`` and ``fluid_model_reason``.
+    (``[fluid] slosh_model``); every vehicle result carries ``fluid_model`` and ``fluid_model_reason``,
+    and the largest step the run took with the rule that chose it (``step``, ``step_reason``:
+    :meth:`Scene.largest_step`).
     Raises :class:`railslosh.slosh.SimulationError` when the run stops early."""
     sc = scene if isinstance(scene, Scene | SloshScene) else load_scene(scene)
     if isinstance(sc, SloshScene):
@@ -35,6 +37,7 @@ def run_scene(
         res["scene"] = sc
         return res
     choice = fluid_model.decide(sc)
+    step, step_reason = sc.largest_step(choice.model if sc.fluid is not None else "rigid")
     rows = np.asarray(sc.track_rows, dtype=float)
     try:
         if sc.fluid is None:
@@ -46,9 +49,10 @@ def run_scene(
         else:
             res = vehicle.run(rows, **sc.rigid_kwargs(), progress=progress)
     except slosh.SimulationError as exc:
-        exc.results.update(fluid_model=choice.model, fluid_model_reason=choice.reason)
+        exc.results.update(
+            fluid_model=choice.model, fluid_model_reason=choice.reason, step=step, step_reason=step_reason
+        )
         raise
-    res["fluid_model"] = choice.model
-    res["fluid_model_reason"] = choice.reason
+    res |= {"fluid_model": choice.model, "fluid_model_reason": choice.reason, "step": step, "step_reason": step_reason}
     res["scene"] = sc
     return res

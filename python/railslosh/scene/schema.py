@@ -96,6 +96,11 @@ class Field:
         return value
 
 
+DEFAULT_STEP = 1e-3
+"""Largest integrator step of a vehicle run whose scene gives no ``[train] step`` and that no rule of
+:meth:`railslosh.scene.Scene.largest_step` covers, s."""
+
+
 def _num(lo: float, hi: float, unit: str, noun: str, default: Any, doc: str, **kw: Any) -> Field:
     return Field("number", doc, default, Limit(lo, hi, unit, noun, lo_open=kw.pop("lo_open", False)), **kw)
 
@@ -315,7 +320,17 @@ SCHEMA: dict[str, dict[str, dict[str, Field]]] = {
                 False,
             ),
             "t_end": _num(0.0, 600.0, "s", "a time", 1.0, "simulated time", lo_open=True),
-            "step": _num(1e-6, 0.01, "s", "a time step", 1e-3, "largest integrator step"),
+            "step": _num(
+                1e-6,
+                0.01,
+                "s",
+                "a time step",
+                None,
+                "largest integrator step",
+                default_doc=f"`{DEFAULT_STEP:g}`; a braked ANCF run of a named oil: its converged step (ECP "
+                f"`{_core.braking_step('all', 'light'):g}`, `{_core.braking_step('all', 'heavy'):g}` with medium or "
+                f"heavy crude; conventional `{_core.braking_step('front', 'light'):g}`)",
+            ),
             "record_every": _num(1e-6, 10.0, "s", "an interval", 0.01, "recording interval (≥ train.step)"),
             "load_filter": _choice(
                 LOAD_FILTERS, "hat_mean", "loads as their hat-weighted mean over the steps, or point samples"

@@ -12,12 +12,12 @@ from typing import Any
 
 import numpy as np
 
-from railslosh import rail, vehicle
+from railslosh import _core, rail, vehicle
 from railslosh.irregularity import Irregularity, from_spec
 from railslosh.limits import Limit, invalid, missing
 from railslosh.scene.common import Outputs, meta, settle_time, vehicle_outputs
 from railslosh.scene.fluid import FluidSpec, vehicle_fluid
-from railslosh.scene.schema import Section, increasing, number_list, scoped, table, unknown_sections
+from railslosh.scene.schema import DEFAULT_STEP, Section, increasing, number_list, scoped, table, unknown_sections
 from railslosh.scene.track import friction_table, irregularity_spec, irregularity_table, track
 
 _BRAKE_TIME = Limit(0.0, 1e4, "s", "a time")
@@ -58,7 +58,9 @@ class Scene:
     speed: float = 0.0
     drive: bool | float = False
     t_end: float = 1.0
-    step: float = 1e-3
+    step: float | None = None
+    """``[train] step``, the largest integrator step, s; ``None`` (not given): chosen for the run by
+    :meth:`largest_step`."""
     record_every: float = 0.01
     load_filter: str = "hat_mean"
     """How load channels are recorded: ``"hat_mean"`` (anti-aliased) or ``"sample"``."""
@@ -127,6 +129,24 @@ class Scene:
         spec = self.irregularity_spec()
         return None if spec is None else from_spec(spec)
 
+    def largest_step(self, model: str = "rigid") -> tuple[float, str]:
+        """The largest integrator step of a run of this scene with liquid model ``model``
+        (``"ancf"``, ``"pendulum"`` or ``"rigid"``), s, and why: ``[train] step`` where the scene
+        gives it; else, for a braked ANCF run of a named oil, the step at which its coupler force is
+        converged (:func:`railslosh._core.braking_step`: 2 ms for ECP with light crude or water,
+        1 ms with medium or heavy crude, 4 ms for conventional braking); else
+        :data:`DEFAULT_STEP`. So a sweep over the oil of a scene without ``step`` gives each oil
+        its own step."""
+        if self.step is not None:
+            return self.step, "train.step"
+        f = self.fluid
+        if model == "ancf" and f is not None and f.oil != "custom" and self.brake_times is not None:
+            scope = "ECP" if self.brake_scope == "all" else "conventional"
+            return _core.braking_step(
+                self.brake_scope, f.oil
+            ), f"{scope} braking of {f.oil} (railslosh._core.braking_step)"
+        return DEFAULT_STEP, "the default"
+
     def run_kwargs(self) -> dict[str, Any]:
         """Keyword arguments of :func:`railslosh.vehicle.run` (after the track)."""
         brake = None
@@ -137,7 +157,7 @@ class Scene:
             "station": self.station,
             "speed": self.speed,
             "t_end": self.t_end,
-            "step": self.step,
+            "step": self.largest_step()[0],
             "record_every": self.record_every,
             "load_filter": self.load_filter,
             "drive": self.drive,
@@ -163,6 +183,7 @@ class Scene:
             kw.pop(k)
         f = self.fluid
         kw |= {
+            "step": self.largest_step("ancf")[0],
             "oil": f.oil if f.oil != "custom" else "light",
             "fluid": f.make_fluid(2.0 * self.tank_radius() * f.fill) if f.oil == "custom" else None,
             "counts": f.counts,
@@ -183,6 +204,7 @@ class Scene:
         for k in ("counts", "snapshot_every", "wall_damping_ratio", "wall_adhesion", "shear_stabilization"):
             kw.pop(k)
         kw["slosh_axis"] = slosh_axis
+        kw["step"] = self.largest_step("pendulum")[0]
         return kw
 
     def rigid_kwargs(self) -> dict[str, Any]:
@@ -220,11 +242,12 @@ def _to_dict(sc: Scene) -> dict[str, Any]:
         "speed": sc.speed,
         "drive": sc.drive,
         "t_end": sc.t_end,
-        "step": sc.step,
         "record_every": sc.record_every,
         "load_filter": sc.load_filter,
         "wheelset_lateral_offset": sc.wheelset_lateral_offset,
     }
+    if sc.step is not None:
+        train["step"] = sc.step
     if sc.coupler_stiffness is not None:
         train["coupler_stiffness"] = sc.coupler_stiffness
     if sc.coupler_damping is not None:
@@ -292,8 +315,9 @@ def _train(doc: Mapping[str, Any], rows: list[list[float]], params: Mapping[str,
     drive = tr.values.get("drive", False)
     if not isinstance(drive, bool):
         drive = tr.field("speed").limit.check(drive, "train.drive", note=" (or true / false)")  # type: ignore[union-attr]
-    out |= {"speed": speed, "drive": drive, "t_end": tr.get("t_end"), "step": tr.get("step")}
-    out["record_every"] = tr.get("record_every", lo=out["step"], note=" (≥ train.step)")
+    out |= {"speed": speed, "drive": drive, "t_end": tr.get("t_end")}
+    out["step"] = tr.get("step") if "step" in tr else None  # None: Scene.largest_step chooses
+    out["record_every"] = tr.get("record_every", lo=out["step"] or DEFAULT_STEP, note=" (≥ train.step)")
     out["load_filter"] = tr.get("load_filter")
     for k in ("wheelset_lateral_offset", "coupler_stiffness", "coupler_damping"):
         out[k] = tr.get(k)

@@ -41,7 +41,7 @@ use rail_mbs::vehicle::{BrakeScope, TankCarParams, TrainScenario};
 
 use crate::{Record, SCENE_WALL_ADHESION, SCENE_WALL_DAMPING};
 
-pub use rail_mbs::defaults::{Oil, SETTLE, brake_torque};
+pub use rail_mbs::defaults::{BRAKING_STEP, ECP_STEP, ECP_STEP_VISCOUS, Oil, SETTLE, brake_torque, braking_step};
 
 /// A braking run of the studies.
 #[derive(Debug, Clone)]
@@ -92,36 +92,6 @@ fn finish(
     out.map_err(|f| {
         AncfError::Solver(format!("{} (at t = {:.3} s)", f.error, f.record.train.t.last().copied().unwrap_or(0.0)))
     })
-}
-
-/// Largest time step of the conventional-braking runs (the front car braked) and of the
-/// shipped conventional-braking scenes, s: their coupler force, the brake difference between
-/// the cars (tens of kN), changes by less than 0.01 % from 4 to 2 ms
-/// (`coupler-force-convergence`).
-pub const BRAKING_STEP: f64 = 4e-3;
-
-/// Largest time step of the ECP runs (every car braked) with light crude or water and of the
-/// shipped light-crude ECP scenes, s. With identical brakes the coupler force is a few tens of
-/// newtons riding on ±50 kN liquid loads, and at 4 ms it is not resolved in time: on the 4×4×2
-/// mesh over 6 s its RMS is 39.2 / 34.9 / 34.5 N at 4 / 2 / 1 ms (12 % then 1.1 %), and tighter
-/// Newton tolerances (1e-7 against 1e-4) move it by no more than the step does (docs/validation.md,
-/// "coupler-force-convergence").
-pub const ECP_STEP: f64 = 2e-3;
-
-/// Largest time step of the ECP runs with the medium and heavy crudes (and of their scenes), s:
-/// their coupler force converges more slowly in the step. On 4×4×2 over 6 s its RMS at
-/// 2 / 1 / 0.5 ms is 29.8 / 28.4 / 27.9 N (medium) and 40.6 / 37.5 / 36.7 N (heavy): 2 ms is
-/// 6.8 % and 10.6 % from the 0.5 ms figure, 1 ms 1.8 % and 2.2 %.
-pub const ECP_STEP_VISCOUS: f64 = 1e-3;
-
-/// The largest time step of a braking run with brake `scope` and liquid `oil` ([`ECP_STEP`],
-/// [`ECP_STEP_VISCOUS`] or [`BRAKING_STEP`]).
-pub fn braking_step(scope: BrakeScope, oil: Oil) -> f64 {
-    match (scope, oil) {
-        (BrakeScope::FrontCar, _) => BRAKING_STEP,
-        (BrakeScope::AllCars, Oil::Medium | Oil::Heavy) => ECP_STEP_VISCOUS,
-        (BrakeScope::AllCars, _) => ECP_STEP,
-    }
 }
 
 /// Runs a braking case (largest step [`braking_step`]).
