@@ -265,3 +265,42 @@ fn the_warm_started_contact_point_converges_with_the_sweep_step() {
         assert!(*worst < 1e-9, "step {step}: {worst}");
     }
 }
+
+/// The mirror images hold with CONTACT's patch rule too (`PatchCombination::contact()`: A_SEP = π,
+/// D_SEP = 8 mm, D_COMB = 4 mm; every two-point contact of this pair is one combined patch):
+/// (ψ, φ) = (−3 mrad, 1.5 mrad), 201 shifts −10 … +10 mm, the left wheel at 60 kN with the rule.
+#[test]
+fn the_mirror_images_hold_with_combined_patches() {
+    use rail_mbs::wheel_rail::PatchCombination;
+    let (mut left, mut right) = (contact(Side::Left), contact(Side::Right));
+    left.settings.patch_combination = PatchCombination::contact();
+    right.settings.patch_combination = PatchCombination::contact();
+    let (v, r0) = (20.0, 0.46);
+    let (yaw, roll) = (-0.003, 0.0015);
+    let (mut worst, mut combined): (f64, usize) = (0.0, 0);
+    for k in 0..=200 {
+        let y = -0.010 + 1e-4 * k as f64;
+        let mut pose = WheelPose {
+            position: Vector3::new(5.0, y, r0),
+            rotation: rot(yaw, roll),
+            velocity: Vector3::new(v, 0.05, 0.0),
+            angular_velocity: Vector3::new(0.0, v / r0 * 1.001, 0.0),
+        };
+        pose.position.z = height_for_load(&mut left, &pose, 6e4, 0.02);
+        let (fl, ml, nl) = resultant(&mut left, &pose);
+        let (fr, mr, nr) = resultant(&mut right, &pose.mirrored());
+        left.reset();
+        combined += usize::from(left.evaluate(&pose).unwrap().iter().any(|p| p.patch.is_some()));
+        assert_eq!(nl.len(), nr.len(), "contact-point count at y = {y}");
+        let scale = fl.norm().max(1.0);
+        let ef = (fr - mirror_vector(&fl)).norm() / scale;
+        let em = (mr - mirror_pseudovector(&ml)).norm() / (ml.norm().max(1.0));
+        let en = nl.iter().zip(&nr).map(|(a, b)| (a - b).abs() / scale).fold(0.0, f64::max);
+        worst = worst.max(ef).max(em).max(en);
+        assert!(ef < 1e-9 && em < 1e-9 && en < 1e-9, "y = {y}: force {ef:e}, moment {em:e}, normal {en:e}");
+    }
+    println!(
+        "combined patches: 201 mirrored poses, {combined} with a combined patch, worst relative difference {worst:.2e}"
+    );
+    assert!(combined >= 10, "the sweep meets combined patches: {combined}");
+}

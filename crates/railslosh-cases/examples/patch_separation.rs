@@ -11,59 +11,36 @@
 //! `dist ≤ D_COMB`, and in between one patch whose two parts interact with the weight
 //! `((D_SEP − dist)/(D_SEP − D_COMB))^0.8`. The Manchester benchmark's values: A_SEP = 90°,
 //! D_SEP = 8 mm, D_COMB = 4 mm.
-use nalgebra::Vector3;
 use rail_mbs::track::Side;
 use rail_mbs::wheel_rail::manchester::{
     MANCHESTER_DIR, MANCHESTER_FILES, find_dataset, manchester_contact_pair, parse_manchester_reference,
 };
 use rail_mbs::wheel_rail::{
-    ContactError, ContactPoint, CreepModel, VerticalTarget, WheelPose, WheelRailContact, WheelState, solve_vertical,
+    ContactError, ContactPoint, CreepModel, PatchCombination, VerticalTarget, WheelPose, WheelRailContact, WheelState,
+    solve_vertical,
 };
 
-const A_SEP: f64 = std::f64::consts::FRAC_PI_2;
-const D_SEP: f64 = 8e-3;
-const D_COMB: f64 = 4e-3;
-
-/// Ends (track y–z, m) of the rigid interpenetration region of point `p`.
-fn region(c: &WheelRailContact, pose: &WheelPose, p: &ContactPoint) -> Result<[Vector3<f64>; 2], ContactError> {
-    let sep = c.separation(pose, &p.geometry, 0.025, 5e-5)?;
-    let d = p.geometry.penetration;
-    let i0 = sep.y.partition_point(|&v| v < 0.0).min(sep.y.len() - 1);
-    let (mut lo, mut hi) = (i0, i0);
-    while lo > 0 && sep.h[lo - 1] < d {
-        lo -= 1;
-    }
-    while hi + 1 < sep.y.len() && sep.h[hi + 1] < d {
-        hi += 1;
-    }
-    let at = |y: f64| {
-        let q = p.point() + p.geometry.e2 * y;
-        Vector3::new(0.0, q.y, q.z)
-    };
-    Ok([at(sep.y[lo]), at(sep.y[hi])])
-}
-
-/// CONTACT's decision for two points: (dist mm, dangle deg, decision). Where the two regions
-/// overlap, the rigid interpenetration is one region, which CONTACT's scan finds as one.
+/// CONTACT's decision for two points: (dist mm, dangle deg, decision), from the library's
+/// interpenetration regions (`WheelRailContact::interpenetration_region`) and rule
+/// (`PatchCombination::coupling`). Where the two regions overlap, the rigid interpenetration is
+/// one region, which CONTACT's scan finds as one.
 fn decide(c: &WheelRailContact, pose: &WheelPose, pts: &[ContactPoint]) -> Result<(f64, f64, String), ContactError> {
-    let (ra, rb) = (region(c, pose, &pts[0])?, region(c, pose, &pts[1])?);
-    // the facing ends: the closest pair of ends (0 when the regions overlap laterally)
-    let (ya, yb) = (pts[0].point().y, pts[1].point().y);
-    let (lo, hi) = if ya < yb { (&ra, &rb) } else { (&rb, &ra) };
-    let end_lo = if lo[0].y > lo[1].y { lo[0] } else { lo[1] };
-    let end_hi = if hi[0].y < hi[1].y { hi[0] } else { hi[1] };
-    let overlap = end_lo.y >= end_hi.y;
-    let dist = if overlap { 0.0 } else { (end_hi - end_lo).norm() };
+    let ra = c.interpenetration_region(pose, &pts[0].geometry)?;
+    let rb = c.interpenetration_region(pose, &pts[1].geometry)?;
+    let dist = ra.distance(&rb);
     let dangle = pts[0].geometry.normal.dot(&pts[1].geometry.normal).clamp(-1.0, 1.0).acos();
-    let decision = if overlap {
+    let rule = PatchCombination::manchester();
+    let PatchCombination::Contact { d_comb, .. } = rule else { unreachable!() };
+    let weight = rule.coupling(dist, dangle);
+    let decision = if dist == 0.0 {
         // CONTACT's scan finds one interpenetration region: one patch before any combining
         "one interpenetration region: one patch".to_string()
-    } else if dangle > A_SEP || dist > D_SEP {
+    } else if weight == 0.0 {
         "two patches".to_string()
-    } else if dist <= D_COMB {
+    } else if dist <= d_comb {
         "one patch".to_string()
     } else {
-        format!("one patch, parts weighted {:.2}", ((D_SEP - dist) / (D_SEP - D_COMB)).powf(0.8))
+        format!("one patch, parts weighted {weight:.2}")
     };
     Ok((dist * 1e3, dangle.to_degrees(), decision))
 }

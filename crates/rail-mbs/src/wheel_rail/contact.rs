@@ -7,7 +7,7 @@ use nalgebra::{Matrix3, Matrix4, Vector3, Vector4};
 use super::ContactError;
 use super::creep::{CreepForces, CreepModel, Creepages, creep_forces};
 use super::hertz::{HertzConstants, Material, combined_modulus};
-use super::kik_piotrowski::{KpPatch, PatchModel, PatchSummary, SampledSeparation};
+use super::kik_piotrowski::{KpPatch, PatchModel, PatchSummary, SampledSeparation, SeparationFn};
 use crate::profile::Profile;
 use crate::track::{Side, Track};
 
@@ -233,7 +233,8 @@ pub struct ContactSettings {
     /// Two solutions closer than this in both lateral parameters (rail `v`, wheel `u`) are
     /// merged (the deeper one kept), m. This removes duplicates of one contact point (two scan
     /// seeds converging to the same minimum of the gap); it is not a patch rule. Two distinct
-    /// minima of the gap stay two Hertzian points however close their patches lie, where
+    /// minima of the gap stay two points however close their patches lie (unless
+    /// [`Self::patch_combination`] combines them), where
     /// CONTACT (A_SEP, D_SEP, D_COMB; the Manchester benchmark input: 90°, 8 mm, 4 mm)
     /// combines interpenetration regions whose facing ends lie within D_SEP into one patch
     /// (docs/validation.md, "One patch or two: our rule and CONTACT's").
@@ -248,6 +249,9 @@ pub struct ContactSettings {
     /// solution; they are evaluated with this floor instead (a documented
     /// approximation — a non-Hertzian model would be needed there).
     pub min_relative_curvature: f64,
+    /// How neighbouring contact points form patches: [`PatchCombination::Separate`] (one patch
+    /// per point, the default) or CONTACT's D_SEP/D_COMB rule ([`PatchCombination::Contact`]).
+    pub patch_combination: PatchCombination,
 }
 
 impl Default for ContactSettings {
@@ -261,6 +265,7 @@ impl Default for ContactSettings {
             always_scan: true,
             min_speed: 0.05,
             min_relative_curvature: 0.1,
+            patch_combination: PatchCombination::Separate,
         }
     }
 }
@@ -349,6 +354,16 @@ impl ContactPoint {
             None => self.point(),
             Some(s) => self.point() + self.geometry.e2 * s.centroid,
         }
+    }
+    /// The same patch carrying `k` times its normal and creep forces and spin moment (a share
+    /// of a blend, [`PatchCombination::Contact`] between `d_comb` and `d_sep`).
+    pub fn scaled(&self, k: f64) -> Self {
+        let mut p = *self;
+        p.normal_force *= k;
+        p.creep.longitudinal *= k;
+        p.creep.lateral *= k;
+        p.creep.spin_moment *= k;
+        p
     }
     /// Contact point (midway between the surface points), m.
     pub fn point(&self) -> Vector3<f64> {
@@ -759,25 +774,51 @@ impl WheelRailContact {
         let (half, spacing) = (0.012, 2.5e-4);
         let s = self.separation(pose, g, half, spacing).ok()?;
         let d = g.penetration;
-        let i0 = s.y.iter().position(|&y| y == 0.0)?;
-        // the crossing h = δ from sample i0 outward in direction `step` (±1), or the last sample
-        let end = |step: isize| {
-            let mut i = i0 as isize;
-            loop {
-                let j = i + step;
-                if j < 0 || j as usize >= s.y.len() {
-                    return s.y[i as usize];
-                }
-                let (hi_, hj) = (s.h[i as usize], s.h[j as usize]);
-                if hj >= d {
-                    let t = (d - hi_) / (hj - hi_);
-                    return s.y[i as usize] + t * (s.y[j as usize] - s.y[i as usize]);
-                }
-                i = j;
-            }
-        };
-        let w = 0.5 * (end(1) - end(-1));
+        let (lo, hi, _) = region_ends(&s, d)?;
+        let w = 0.5 * (hi - lo);
         (w > 0.0).then(|| d / (w * w))
+    }
+
+    /// The rigid interpenetration region of loaded contact `g` (penetration > 0), the region
+    /// CONTACT's patch rule compares ([`PatchCombination`]): where the undeformed separation
+    /// across the contact ([`Self::separation`], sampled every [`KP_SEPARATION_SPACING`] over
+    /// ±[`KP_SEPARATION_HALF_WIDTH`]) stays below the penetration, connected to the contact
+    /// point, its ends interpolated linearly between the samples.
+    pub fn interpenetration_region(
+        &self,
+        pose: &WheelPose,
+        g: &ContactGeometry,
+    ) -> Result<InterpenetrationRegion, ContactError> {
+        self.region_and_separation(pose, g).map(|(r, _)| r)
+    }
+
+    /// [`Self::interpenetration_region`] and the separation it was found on.
+    fn region_and_separation(
+        &self,
+        pose: &WheelPose,
+        g: &ContactGeometry,
+    ) -> Result<(InterpenetrationRegion, SampledSeparation), ContactError> {
+        if g.penetration.is_nan() || g.penetration <= 0.0 {
+            return Err(ContactError::InvalidInput(format!(
+                "interpenetration region: penetration {:e} m, must be > 0",
+                g.penetration
+            )));
+        }
+        let sep = self.separation(pose, g, KP_SEPARATION_HALF_WIDTH, KP_SEPARATION_SPACING)?;
+        let (lo, hi, truncated) = region_ends(&sep, g.penetration).ok_or_else(|| {
+            ContactError::InvalidInput("interpenetration region: no sample at the contact point".into())
+        })?;
+        // the ends in the rail profile's plane (lateral coordinate v to the field side, height z)
+        let sg = self.rail.side.sign();
+        let fd = self.rail.frame_derivs(g.params[0]);
+        let p = 0.5 * (g.point_rail + g.point_wheel);
+        let section = |y: f64| {
+            let l = fd.rot.transpose() * (p + g.e2 * y - fd.origin);
+            (sg * l.y, l.z)
+        };
+        let (a, b) = (section(lo), section(hi));
+        let ends = if a.0 <= b.0 { [a, b] } else { [b, a] };
+        Ok((InterpenetrationRegion { lateral: (lo, hi), ends, truncated }, sep))
     }
 
     /// A scan minimum farther from the rail than this (a tenth of the seeds' gap limit) is
@@ -1043,8 +1084,24 @@ impl WheelRailContact {
         KpPatch::at_penetration(&sep, g.penetration, epsilon, strips, e_star)
     }
 
-    /// The geometries in contact (`δ > 0`) with their normal and creep forces, into `out`.
+    /// The geometries in contact (`δ > 0`) with their normal and creep forces, into `out`:
+    /// one patch per point, then combined by [`ContactSettings::patch_combination`].
     fn loaded_points(
+        &self,
+        pose: &WheelPose,
+        geoms: &[ContactGeometry],
+        prescribed: Option<&Creepages>,
+        out: &mut Vec<ContactPoint>,
+    ) -> Result<(), ContactError> {
+        self.loaded_points_separate(pose, geoms, prescribed, out)?;
+        if self.settings.patch_combination != PatchCombination::Separate {
+            self.combine_patches(pose, geoms, prescribed, out)?;
+        }
+        Ok(())
+    }
+
+    /// [`Self::loaded_points`], one patch per point.
+    fn loaded_points_separate(
         &self,
         pose: &WheelPose,
         geoms: &[ContactGeometry],
@@ -1153,6 +1210,208 @@ impl WheelRailContact {
         }
         Ok(())
     }
+
+    /// CONTACT's patch rule ([`PatchCombination::Contact`]) on the separate patches `out` of
+    /// `geoms`: neighbouring loaded points (in the order of the wheel's lateral coordinate,
+    /// taken in pairs from the first) whose regions couple with weight `c > 0`
+    /// ([`PatchCombination::coupling`]) get one combined patch ([`Self::combined_patch`]); with
+    /// `c = 1` it replaces their separate patches, with `0 < c < 1` the separate patches carry
+    /// `1 − c` of their forces and the combined patch `c` of its own, so that the force is
+    /// continuous where `dist` crosses `d_sep`.
+    fn combine_patches(
+        &self,
+        pose: &WheelPose,
+        geoms: &[ContactGeometry],
+        prescribed: Option<&Creepages>,
+        out: &mut Vec<ContactPoint>,
+    ) -> Result<(), ContactError> {
+        let rule = self.settings.patch_combination;
+        rule.validate()?;
+        let loaded: Vec<ContactGeometry> = geoms.iter().filter(|g| g.penetration > 0.0).copied().collect();
+        if loaded.len() < 2 {
+            return Ok(());
+        }
+        let regions =
+            loaded.iter().map(|g| self.region_and_separation(pose, g)).collect::<Result<Vec<_>, ContactError>>()?;
+        let mut i = 0;
+        while i + 1 < loaded.len() {
+            let (a, b) = (loaded[i], loaded[i + 1]);
+            let dist = regions[i].0.distance(&regions[i + 1].0);
+            let angle = a.normal.dot(&b.normal).clamp(-1.0, 1.0).acos();
+            let c = rule.coupling(dist, angle);
+            if c <= 0.0 {
+                i += 1;
+                continue;
+            }
+            let combined = self.combined_patch(pose, [&a, &b], [&regions[i], &regions[i + 1]], prescribed)?;
+            if c >= 1.0 {
+                out.retain(|p| p.geometry != a && p.geometry != b);
+                out.push(combined);
+            } else {
+                for p in out.iter_mut().filter(|p| p.geometry == a || p.geometry == b) {
+                    *p = p.scaled(1.0 - c);
+                }
+                out.push(combined.scaled(c));
+            }
+            i += 2;
+        }
+        out.sort_by(|p, q| p.geometry.params[2].total_cmp(&q.geometry.params[2]));
+        Ok(())
+    }
+
+    /// The combined patch of two loaded points `pair` with their regions and separations: a
+    /// Kik–Piotrowski patch ([`KpPatch::combined`]; ε and strips of the patch model, the
+    /// published ε = 0.55 and 60 strips with Hertz) over the union of the two regions, its
+    /// normal force from the elastic approach held at both points weighted by their
+    /// interpenetrations `W_k` (each point's rigid interpenetration area on its own side of the
+    /// saddle of the separation between them). Its normal is turned about `e1` to the
+    /// `W`-weighted mean of the two contact angles and its reference point is the `W`-weighted
+    /// mean of the two points (CONTACT's reference angle and position); there the creepages are
+    /// taken. The patch is computed in the frame of each point (its separation, its normal turned
+    /// by the other's share of the angle) and the two results are averaged with the weights
+    /// `W_k`, so that nothing changes discontinuously where the deeper point changes (the patch
+    /// in the frame of the deeper point alone jumped by 13 % in the longitudinal force there).
+    /// Friction: the `W`-weighted mean of the two points' μ. The point carries the surface
+    /// parameters of the point with the larger weight and the larger penetration.
+    fn combined_patch(
+        &self,
+        pose: &WheelPose,
+        pair: [&ContactGeometry; 2],
+        regions: [&(InterpenetrationRegion, SampledSeparation); 2],
+        prescribed: Option<&Creepages>,
+    ) -> Result<ContactPoint, ContactError> {
+        let (epsilon, strips) = match self.patch_model {
+            PatchModel::KikPiotrowski { epsilon, strips } => (epsilon, strips),
+            PatchModel::Hertz => (super::kik_piotrowski::DEFAULT_EPSILON, super::kik_piotrowski::DEFAULT_STRIPS),
+        };
+        let at = |g: &ContactGeometry| 0.5 * (g.point_rail + g.point_wheel);
+        let weight = |k: usize| {
+            let (g, o) = (pair[k], pair[1 - k]);
+            let (region, sep) = regions[k];
+            part_weight(sep, g.penetration, region.lateral, (at(o) - at(g)).dot(&g.e2))
+        };
+        let total = weight(0) + weight(1);
+        let w = [weight(0) / total, weight(1) / total];
+        let mu = w[0] * self.friction_at(&pair[0].params) + w[1] * self.friction_at(&pair[1].params);
+        let e_star = combined_modulus(&self.wheel_material, &self.rail_material);
+        let g_mod = 2.0 / (1.0 / self.wheel_material.shear_modulus() + 1.0 / self.rail_material.shear_modulus());
+        let nu = 0.5 * (self.wheel_material.poisson + self.rail_material.poisson);
+        let speed = pose.velocity.norm().max(self.settings.min_speed);
+        // the patch in the frame of point d
+        let in_frame =
+            |d: usize| -> Result<(ContactGeometry, f64, f64, CreepForces, Creepages, KpPatch), ContactError> {
+                let (gd, go, sep) = (pair[d], pair[1 - d], &regions[d].1);
+                // the union of the regions along d's e2, from d's point
+                let along = |k: usize, y: f64| (at(pair[k]) + pair[k].e2 * y - at(gd)).dot(&gd.e2);
+                let mut span = (0.0f64, 0.0f64);
+                for (k, region) in regions.iter().enumerate() {
+                    let (lo, hi) = region.0.lateral;
+                    for y in [along(k, lo), along(k, hi)] {
+                        span = (span.0.min(y), span.1.max(y));
+                    }
+                }
+                let y_o = along(1 - d, 0.0);
+                let delta_o = (gd.penetration - sep.at(y_o).0).max(0.0);
+                let approach = [(0.0, gd.penetration, w[d]), (y_o, delta_o, w[1 - d])];
+                let mut patch = KpPatch::combined(sep, gd.penetration, epsilon, strips, e_star, span, &approach)?;
+                // the reference angle and point: d's normal turned about e1 by the other's share of
+                // the angle between the normals, the weighted mean of the points
+                let turn = gd.normal.cross(&go.normal).dot(&gd.e1).atan2(gd.normal.dot(&go.normal));
+                let phi = w[1 - d] * turn;
+                let shift = w[1 - d] * y_o;
+                let mut g = *gd;
+                g.point_rail += gd.e2 * shift;
+                g.point_wheel += gd.e2 * shift;
+                g.normal = gd.normal * phi.cos() - gd.e2 * phi.sin();
+                g.e2 = g.normal.cross(&g.e1);
+                for s in &mut patch.strips {
+                    s.y -= shift;
+                }
+                patch.lateral_extent = (patch.lateral_extent.0 - shift, patch.lateral_extent.1 - shift);
+                patch.centroid -= shift;
+                let v = pose.velocity + pose.angular_velocity.cross(&(at(&g) - pose.position));
+                let pen_rate = -v.dot(&g.normal);
+                let fn_ = (patch.normal_force * (1.0 + self.damping * pen_rate)).max(0.0);
+                let patch = patch.scaled_to(fn_);
+                let creepages = prescribed.copied().unwrap_or(Creepages {
+                    longitudinal: v.dot(&g.e1) / speed,
+                    lateral: v.dot(&g.e2) / speed,
+                    spin: pose.angular_velocity.dot(&g.normal) / speed,
+                });
+                let creep = patch.creep(self.creep_model, &creepages, mu, g_mod, nu);
+                Ok((g, pen_rate, fn_, creep, creepages, patch))
+            };
+        let (a, b) = (in_frame(0)?, in_frame(1)?);
+        let mix = |x: f64, y: f64| w[0] * x + w[1] * y;
+        let mix3 = |x: Vector3<f64>, y: Vector3<f64>| x * w[0] + y * w[1];
+        let main = usize::from(w[1] > w[0] || (w[1] == w[0] && pair[1].penetration > pair[0].penetration));
+        let mut g = if main == 0 { a.0 } else { b.0 };
+        g.point_rail = mix3(a.0.point_rail, b.0.point_rail);
+        g.point_wheel = mix3(a.0.point_wheel, b.0.point_wheel);
+        g.normal = mix3(a.0.normal, b.0.normal).normalize();
+        let e1 = mix3(a.0.e1, b.0.e1);
+        g.e1 = (e1 - g.normal * e1.dot(&g.normal)).normalize();
+        g.e2 = g.normal.cross(&g.e1);
+        g.penetration = pair[0].penetration.max(pair[1].penetration);
+        let kmin = self.settings.min_relative_curvature;
+        let hertz = HertzConstants::new(g.curvature_x.max(kmin), g.curvature_y.max(kmin), e_star)?;
+        let (pa, pb) = (a.5.summary(), b.5.summary());
+        let summary = PatchSummary {
+            lateral_extent: (
+                mix(pa.lateral_extent.0, pb.lateral_extent.0),
+                mix(pa.lateral_extent.1, pb.lateral_extent.1),
+            ),
+            max_half_length: mix(pa.max_half_length, pb.max_half_length),
+            area: mix(pa.area, pb.area),
+            centroid: mix(pa.centroid, pb.centroid),
+            max_pressure: mix(pa.max_pressure, pb.max_pressure),
+            truncated: pa.truncated || pb.truncated,
+        };
+        let (ea, eb) = (a.5.equivalent_ellipse(), b.5.equivalent_ellipse());
+        Ok(ContactPoint {
+            geometry: g,
+            hertz,
+            semi_axes: (mix(ea.0, eb.0), mix(ea.1, eb.1)),
+            penetration_rate: mix(a.1, b.1),
+            normal_force: mix(a.2, b.2),
+            creepages: Creepages {
+                longitudinal: mix(a.4.longitudinal, b.4.longitudinal),
+                lateral: mix(a.4.lateral, b.4.lateral),
+                spin: mix(a.4.spin, b.4.spin),
+            },
+            creep: CreepForces {
+                longitudinal: mix(a.3.longitudinal, b.3.longitudinal),
+                lateral: mix(a.3.lateral, b.3.lateral),
+                spin_moment: mix(a.3.spin_moment, b.3.spin_moment),
+            },
+            patch: Some(summary),
+        })
+    }
+}
+
+/// The rigid interpenetration `∫ (d − h)₊ dy` of the region `lateral` of separation `s` on the
+/// near side of the saddle towards `toward` (the other point's position along `y`): the region
+/// is cut at the largest `h` between 0 and `toward`, which lies beyond the region while the two
+/// regions are apart and splits the one region they form once they overlap (continuous as they
+/// merge). Trapezoidal rule on the samples.
+fn part_weight(s: &SampledSeparation, d: f64, lateral: (f64, f64), toward: f64) -> f64 {
+    let (a, b) = if toward >= 0.0 { (0.0, toward) } else { (toward, 0.0) };
+    let (mut saddle, mut h_max) = (toward, f64::NEG_INFINITY);
+    for (&y, &h) in s.y.iter().zip(&s.h) {
+        if y >= a && y <= b && h > h_max {
+            (saddle, h_max) = (y, h);
+        }
+    }
+    let (from, to) =
+        if toward >= 0.0 { (lateral.0, saddle.min(lateral.1)) } else { (saddle.max(lateral.0), lateral.1) };
+    let f = |k: usize| (d - s.h[k]).max(0.0);
+    let mut sum = 0.0;
+    for k in 1..s.y.len() {
+        if s.y[k - 1] >= from && s.y[k] <= to {
+            sum += 0.5 * (f(k - 1) + f(k)) * (s.y[k] - s.y[k - 1]);
+        }
+    }
+    sum
 }
 
 /// A contact is conformal where its relative lateral curvature is below this fraction of the
@@ -1167,6 +1426,139 @@ pub const CONFORMAL_REGION_FACTOR: f64 = 0.5;
 pub const KP_SEPARATION_HALF_WIDTH: f64 = 0.025;
 /// Spacing of the separation samples of a Kik–Piotrowski patch, m.
 pub const KP_SEPARATION_SPACING: f64 = 5e-5;
+
+/// The ends `(lo, hi, truncated)` along the separation's `y` of the region `h(y) < d` connected
+/// to the sample at `y = 0`, each interpolated linearly between the samples; an end beyond the
+/// sampled range is the last sample (`truncated`).
+fn region_ends(s: &SampledSeparation, d: f64) -> Option<(f64, f64, bool)> {
+    let i0 = s.y.iter().position(|&y| y == 0.0)?;
+    let mut truncated = false;
+    // the crossing h = d from sample i0 outward in direction `step` (±1), or the last sample
+    let mut end = |step: isize| {
+        let mut i = i0 as isize;
+        loop {
+            let j = i + step;
+            if j < 0 || j as usize >= s.y.len() {
+                truncated = true;
+                return s.y[i as usize];
+            }
+            let (hi_, hj) = (s.h[i as usize], s.h[j as usize]);
+            if hj >= d {
+                let t = (d - hi_) / (hj - hi_);
+                return s.y[i as usize] + t * (s.y[j as usize] - s.y[i as usize]);
+            }
+            i = j;
+        }
+    };
+    let hi = end(1);
+    let lo = end(-1);
+    Some((lo, hi, truncated))
+}
+
+/// The rigid interpenetration region of a contact point ([`WheelRailContact::interpenetration_region`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct InterpenetrationRegion {
+    /// Ends along the contact's `e2` from the contact point, m (`lo ≤ 0 ≤ hi`).
+    pub lateral: (f64, f64),
+    /// The ends in the rail profile's plane `(v, z)` (`v` the profile's lateral coordinate, to
+    /// the field side; `z` up), m, ordered by `v`: CONTACT's track y–z plane up to the rail's
+    /// cant (a rotation), the same for both rails (mirror images give equal coordinates).
+    pub ends: [(f64, f64); 2],
+    /// Whether an end is the end of the sampled separation (the region may be wider).
+    pub truncated: bool,
+}
+
+impl InterpenetrationRegion {
+    /// CONTACT's `dist` between two regions: the distance in the rail profile's plane between
+    /// their facing ends, 0 where they overlap (one region).
+    pub fn distance(&self, other: &Self) -> f64 {
+        let (lo, hi) = if self.ends[0].0 <= other.ends[0].0 { (self, other) } else { (other, self) };
+        let (a, b) = (lo.ends[1], hi.ends[0]);
+        if a.0 >= b.0 { 0.0 } else { (b.0 - a.0).hypot(b.1 - a.1) }
+    }
+}
+
+/// How neighbouring contact points (local minima of the gap) form contact patches
+/// ([`ContactSettings::patch_combination`]; docs/validation.md, "One patch or two").
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum PatchCombination {
+    /// One patch per contact point (Hertz's ellipse or a Kik–Piotrowski patch), never combined:
+    /// the default.
+    #[default]
+    Separate,
+    /// CONTACT's rule (`A_SEP`, `D_SEP`, `D_COMB`; module `m_wr_locatecp`): two neighbouring
+    /// loaded points whose rigid interpenetration regions ([`InterpenetrationRegion`]) lie within
+    /// `d_sep` of each other (facing ends) and whose normals differ by at most `a_sep` form one
+    /// Kik–Piotrowski patch over the union of their regions ([`KpPatch::combined`]); within
+    /// `d_comb` fully, between `d_comb` and `d_sep` blended with the separate patches by the
+    /// coupling weight `((d_sep − dist)/(d_sep − d_comb))^0.8` (1 at `d_comb`, 0 at `d_sep`).
+    Contact {
+        /// Largest angle between the two contact normals that may combine, rad, in (0, π].
+        a_sep: f64,
+        /// Largest distance between the regions' facing ends that may combine, m, > `d_comb`.
+        d_sep: f64,
+        /// Distance up to which the two are one patch, m, ≥ 0.
+        d_comb: f64,
+    },
+}
+
+/// Allowed range of `d_sep` and `d_comb`, m.
+pub const PATCH_DISTANCE_RANGE: (f64, f64) = (0.0, 0.1);
+
+impl PatchCombination {
+    /// CONTACT's rule with its program defaults: A_SEP = π, D_SEP = 8 mm, D_COMB = 4 mm.
+    pub fn contact() -> Self {
+        Self::Contact { a_sep: std::f64::consts::PI, d_sep: 8e-3, d_comb: 4e-3 }
+    }
+
+    /// CONTACT's rule with the Manchester benchmark's input (`mbench_a22_left.inp`):
+    /// A_SEP = 90°, D_SEP = 8 mm, D_COMB = 4 mm.
+    pub fn manchester() -> Self {
+        Self::Contact { a_sep: std::f64::consts::FRAC_PI_2, d_sep: 8e-3, d_comb: 4e-3 }
+    }
+
+    /// Checks the parameters (typed error naming the field and its allowed range).
+    pub fn validate(&self) -> Result<(), ContactError> {
+        if let Self::Contact { a_sep, d_sep, d_comb } = *self {
+            let bad = |field: &str, value: f64, allowed: String| {
+                ContactError::InvalidInput(ancf_core::error::invalid(field, value, &allowed).to_string())
+            };
+            let pi = std::f64::consts::PI;
+            if !(a_sep.is_finite() && a_sep > 0.0 && a_sep <= pi) {
+                return Err(bad("patch_combination.a_sep", a_sep, format!("an angle in (0, {pi}] rad")));
+            }
+            let (lo, hi) = PATCH_DISTANCE_RANGE;
+            if !(d_comb.is_finite() && (lo..hi).contains(&d_comb)) {
+                return Err(bad("patch_combination.d_comb", d_comb, format!("a distance in [{lo}, {hi}) m")));
+            }
+            if !(d_sep.is_finite() && d_sep > d_comb && d_sep <= hi) {
+                return Err(bad(
+                    "patch_combination.d_sep",
+                    d_sep,
+                    format!("a distance in (d_comb = {d_comb}, {hi}] m"),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The coupling of two regions `dist` apart (m) whose normals differ by `angle` (rad): 0
+    /// two patches, 1 one patch, in between CONTACT's weight of the separator.
+    pub fn coupling(&self, dist: f64, angle: f64) -> f64 {
+        match *self {
+            Self::Separate => 0.0,
+            Self::Contact { a_sep, d_sep, d_comb } => {
+                if angle > a_sep || dist >= d_sep {
+                    0.0
+                } else if dist <= d_comb {
+                    1.0
+                } else {
+                    ((d_sep - dist) / (d_sep - d_comb)).powf(0.8)
+                }
+            }
+        }
+    }
+}
 
 /// Convex curvature tensor of a surface in the basis `(e1, e2)` of the common tangent
 /// plane. `sign = −1` when `n` is the outward normal of the surface, `+1` when `−n` is.

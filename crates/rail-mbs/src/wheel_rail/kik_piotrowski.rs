@@ -416,6 +416,126 @@ impl KpPatch {
         })
     }
 
+    /// One patch over the union of several interpenetration regions (CONTACT's combined patch,
+    /// [`super::contact::PatchCombination`]): the virtual interpenetration `g(y) = ε δ − h(y)`
+    /// of the separation `sep` (`y = 0` at the deepest point, `h(0) = 0`, penetration `delta`)
+    /// over `span` (the union of the rigid regions, m), without the single patch's stop at a
+    /// saddle of `h`: every interval of `span` where `g > 0` is a lobe, and the `strips` strips
+    /// are shared among the lobes in proportion to their widths (at least one each). One
+    /// pressure law over all lobes, `p = (N/Σ(π/2) x_l² Δy) √(x_l² − x²)`, and `N` from the
+    /// elastic approach held in the mean over the regions: for `approach = [(y_k, δ_k, W_k)]`
+    /// (each region's point, its rigid penetration in this frame, its weight)
+    /// `Σ W_k (u(y_k) − δ_k) = 0`, `u(y_k)` the half-space displacement at `y_k`. With one
+    /// region (or the other weights zero) this is the single patch's condition at `y = 0`, and
+    /// where no saddle limits the single patch (the other lobes empty) the patch is
+    /// [`Self::at_penetration`]'s.
+    pub fn combined(
+        sep: &impl SeparationFn,
+        delta: f64,
+        epsilon: f64,
+        strips: usize,
+        e_star: f64,
+        span: (f64, f64),
+        approach: &[(f64, f64, f64)],
+    ) -> Result<Self, ContactError> {
+        PatchModel::KikPiotrowski { epsilon, strips }.validate()?;
+        if !(delta.is_finite() && delta > 0.0) {
+            return Err(invalid("penetration", delta, "a finite penetration > 0 m"));
+        }
+        let gv = epsilon * delta;
+        let g = |y: f64| gv - sep.at(y).0;
+        let (lo_end, hi_end) = sep.range();
+        let (lo, hi) = (span.0.max(lo_end), span.1.min(hi_end));
+        if !(lo <= 0.0 && hi >= 0.0 && g(0.0) > 0.0) {
+            return Err(ContactError::InvalidInput(format!(
+                "Kik-Piotrowski combined patch: span [{lo:e}, {hi:e}] m must hold the deepest point y = 0 with g > 0"
+            )));
+        }
+        let truncated = lo > span.0 || hi < span.1;
+        // the lobes: intervals where g > 0, found on a grid of 400 steps per side of 0 (the
+        // single patch's march) and refined by bisection
+        let crossing = |inside: f64, outside: f64| {
+            let (mut a, mut b) = (inside, outside);
+            for _ in 0..60 {
+                let m = 0.5 * (a + b);
+                if g(m) > 0.0 { a = m } else { b = m }
+            }
+            0.5 * (a + b)
+        };
+        let n = 400;
+        let mut grid: Vec<f64> = (0..=n).rev().map(|i| lo * i as f64 / n as f64).collect();
+        grid.extend((1..=n).map(|i| hi * i as f64 / n as f64));
+        let mut lobes: Vec<(f64, f64)> = Vec::new();
+        let mut start: Option<f64> = (g(grid[0]) > 0.0).then_some(grid[0]);
+        for w in grid.windows(2) {
+            let (a, b) = (w[0], w[1]);
+            match (start, g(b) > 0.0) {
+                (None, true) => start = Some(if g(a) > 0.0 { a } else { crossing(b, a) }),
+                (Some(s), false) => {
+                    lobes.push((s, crossing(a, b)));
+                    start = None;
+                }
+                _ => {}
+            }
+        }
+        if let Some(s) = start {
+            lobes.push((s, hi));
+        }
+        lobes.retain(|l| l.1 > l.0);
+        let total: f64 = lobes.iter().map(|l| l.1 - l.0).sum();
+        let mut out = Vec::with_capacity(strips + lobes.len());
+        let (mut num, mut area, mut moment, mut x_max) = (0.0, 0.0, 0.0, 0.0f64);
+        let mut den = vec![0.0; approach.len()];
+        for &(a, b) in &lobes {
+            let k = ((strips as f64 * (b - a) / total).round() as usize).max(1);
+            let width = (b - a) / k as f64;
+            for j in 0..k {
+                let y = a + (j as f64 + 0.5) * width;
+                let (h, ax) = sep.at(y);
+                let xl = ((gv - h).max(0.0) / ax).sqrt();
+                let q = std::f64::consts::FRAC_PI_2 * xl * xl * width;
+                num += q;
+                moment += q * y;
+                area += 2.0 * xl * width;
+                x_max = x_max.max(xl);
+                if xl > 0.0 {
+                    for (d, &(yk, _, _)) in den.iter_mut().zip(approach) {
+                        *d += strip_kernel(xl, y - 0.5 * width - yk, y + 0.5 * width - yk);
+                    }
+                }
+                out.push(PatchStrip { y, width, half_length: xl, peak_pressure: 0.0 });
+            }
+        }
+        let (mut rigid, mut elastic) = (0.0, 0.0);
+        for (&(_, dk, wk), d) in approach.iter().zip(&den) {
+            rigid += wk * dk;
+            elastic += wk * d;
+        }
+        if !(elastic > 0.0 && rigid > 0.0) {
+            return Err(ContactError::InvalidInput(
+                "Kik-Piotrowski combined patch: the approach weights must be positive".into(),
+            ));
+        }
+        let force = std::f64::consts::PI * e_star * num * rigid / elastic;
+        for s in &mut out {
+            s.peak_pressure = force * s.half_length / num;
+        }
+        let (_, a0) = sep.at(0.0);
+        let xl0 = (g(0.0) / a0).sqrt();
+        Ok(Self {
+            penetration: delta,
+            epsilon,
+            normal_force: force,
+            strips: out,
+            lateral_extent: (lobes[0].0, lobes[lobes.len() - 1].1),
+            truncated,
+            max_half_length: x_max,
+            area,
+            centroid: moment / num,
+            max_pressure: force * xl0 / num,
+        })
+    }
+
     /// The patch carrying the normal force `force` (N, > 0): the penetration by a bracketed
     /// solve of `N(δ) = force` (doubling from 1 µm, then Illinois regula falsi to 1e-12
     /// relative in `δ`).
@@ -485,7 +605,14 @@ impl KpPatch {
         }
         let w = (hi - lo) / self.strips.len() as f64;
         let j = (((y - lo) / w) as usize).min(self.strips.len() - 1);
-        let s = &self.strips[j];
+        let mut s = &self.strips[j];
+        if (y - s.y).abs() > 0.5 * s.width {
+            // a combined patch's strips differ in width between its lobes (Self::combined)
+            match self.strips.iter().find(|s| (y - s.y).abs() <= 0.5 * s.width) {
+                Some(found) => s = found,
+                None => return 0.0,
+            }
+        }
         if s.half_length <= 0.0 || x.abs() >= s.half_length {
             return 0.0;
         }

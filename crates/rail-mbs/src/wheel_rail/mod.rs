@@ -49,7 +49,9 @@
 //!   two Hertzian points instead.
 //! * One point per minimum of the gap: solutions within [`ContactSettings::merge_distance`]
 //!   (1 mm in both lateral parameters) are one point found twice and are merged; distinct
-//!   minima are never combined into one patch. CONTACT decides between one patch and two on
+//!   minima are not combined into one patch by default
+//!   ([`ContactSettings::patch_combination`] = [`PatchCombination::Separate`]); with
+//!   [`PatchCombination::Contact`] they are, by CONTACT's rule. CONTACT decides between one patch and two on
 //!   the interpenetration regions instead: regions whose contact angles differ by at most
 //!   A_SEP and whose facing ends lie within D_SEP are one patch (fully merged within D_COMB,
 //!   between D_COMB and D_SEP one patch of two weakly coupled parts). On S1002/UIC 60 at 1:40
@@ -86,8 +88,8 @@ pub mod manchester;
 pub mod static_load;
 
 pub use contact::{
-    ContactGeometry, ContactMethod, ContactPoint, ContactSettings, RailGeometry, RailPath, WheelGeometry, WheelPose,
-    WheelRailContact, mirror_pseudovector, mirror_vector,
+    ContactGeometry, ContactMethod, ContactPoint, ContactSettings, InterpenetrationRegion, PatchCombination,
+    RailGeometry, RailPath, WheelGeometry, WheelPose, WheelRailContact, mirror_pseudovector, mirror_vector,
 };
 pub use creep::{
     CreepForces, CreepModel, Creepages, KalkerCoefficients, PatchStrip, creep_forces, fastsim_flexibilities,
