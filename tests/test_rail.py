@@ -528,6 +528,44 @@ def test_bad_patch_model_input_names_the_field(s1002_uic60, kwargs, field):
     assert ": expected " in str(info.value)
 
 
+def test_contacts_patch_rule_makes_one_patch_of_two_close_points(s1002_uic60):
+    """Issue 21: with CONTACT's D_SEP/D_COMB rule (`patch_combination="contact"`) the two tread
+    points S1002 finds on UIC 60 at 1:40 near the centred position (about 10 mm apart, their
+    interpenetration regions overlapping) are one patch carrying the same load, placed between
+    them; the default keeps one patch per point."""
+    wheel, head = s1002_uic60
+    kw = dict(rail_cant=1 / 40, load=60e3, speed=20.0, creep_model="fastsim")
+    for shift in (0.0003, 0.0006):
+        separate = rail.contact(wheel, head, lateral_shift=shift, **kw)
+        assert len(separate["normal_force"]) == 2, shift
+        one = rail.contact(wheel, head, lateral_shift=shift, patch_combination="contact", **kw)
+        assert len(one["normal_force"]) == 1, shift
+        assert one["vertical_force"] == pytest.approx(60e3, rel=1e-9)
+        lo, hi = sorted(separate["y_track"])
+        assert lo < one["y_track"][0] < hi
+        # wider than either separate patch: it spans both regions
+        assert one["patch_width"][0] > separate["patch_width"].max()
+    # normals about 2 degrees apart: a rule that combines only below 0.5 degrees keeps the two
+    apart = rail.contact(wheel, head, lateral_shift=0.0006, patch_combination="contact", a_sep=0.009, **kw)
+    assert len(apart["normal_force"]) == 2
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "field"),
+    [
+        (dict(patch_combination="merge"), "patch_combination"),
+        (dict(d_sep=0.008), "d_sep"),
+        (dict(patch_combination="contact", d_sep=0.002, d_comb=0.004), "d_sep"),
+        (dict(patch_combination="contact", a_sep=4.0), "a_sep"),
+        (dict(patch_combination="contact", d_comb=-1e-3), "d_comb"),
+    ],
+)
+def test_bad_patch_combination_input_names_the_field(s1002_uic60, kwargs, field):
+    wheel, head = s1002_uic60
+    with pytest.raises(ValueError, match=f"`(patch_combination\\.)?{field}`"):
+        rail.contact(wheel, head, rail_cant=1 / 40, load=50e3, **kwargs)
+
+
 @pytest.mark.parametrize("mu", [0.3, 0.5])
 def test_a_wheel_pushed_into_flange_contact_climbs_at_the_nadal_limit(s1002_uic60, mu):
     """Issue 21 (derailment use), quasi-static: the left S1002 wheel carries 50 kN and slides on the

@@ -304,6 +304,10 @@ def wheel_rail_contact(
     patch_model: str = "hertz",
     kp_epsilon: float | None = None,
     kp_strips: int | None = None,
+    patch_combination: str = "separate",
+    a_sep: float | None = None,
+    d_sep: float | None = None,
+    d_comb: float | None = None,
 ) -> dict[str, Any]: ...
 
 # --- vehicle (crates/railslosh-py/src/vehicle.rs) ---

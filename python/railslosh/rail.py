@@ -382,6 +382,10 @@ def contact(
     patch_model: str = "hertz",
     kp_epsilon: float | None = None,
     kp_strips: int | None = None,
+    patch_combination: str = "separate",
+    a_sep: float | None = None,
+    d_sep: float | None = None,
+    d_comb: float | None = None,
 ) -> dict[str, Any]:
     """Contact of one wheel of a wheelset on its straight rail, at the height that carries ``load``
     (total vertical force on the wheel, N) or reaches ``penetration`` (largest contact penetration,
@@ -414,6 +418,15 @@ def contact(
     [0.05, 1]) and ``kp_strips`` its number of strips (default 60, 4–5000). FASTSIM then runs on the
     patch's strips; the other creep laws use its equivalent ellipse (same area and length-to-width
     ratio), which ``semi_axis_a`` / ``semi_axis_b`` report.
+
+    Patches of several points: ``patch_combination="separate"`` (the default: one patch per local
+    minimum of the gap) or ``"contact"``: CONTACT's rule, under which two neighbouring points whose
+    rigid interpenetration regions lie within ``d_sep`` (m, default 8 mm; facing ends) and whose
+    normals differ by at most ``a_sep`` (rad, default π) form one Kik–Piotrowski patch over both
+    regions, fully within ``d_comb`` (default 4 mm), blended with the separate patches between
+    ``d_comb`` and ``d_sep`` (the Manchester benchmark's input is ``a_sep = π/2``). It reproduces
+    CONTACT's one patch at the benchmark's centred wheelset in force, width and position but not
+    its creep forces (docs/validation.md, "One patch or two").
 
     The wheel is lowered onto the rail from 50 mm above its nominal height, so for a shift beyond
     flange contact (about 8 mm for S1002 on UIC 60) the flange may land on the rail head (a derailed
@@ -471,6 +484,10 @@ def contact(
         patch_model=patch_model,
         kp_epsilon=None if kp_epsilon is None else _number(kp_epsilon, "kp_epsilon"),
         kp_strips=None if kp_strips is None else _count(kp_strips, "kp_strips"),
+        patch_combination=patch_combination,
+        a_sep=None if a_sep is None else _number(a_sep, "a_sep"),
+        d_sep=None if d_sep is None else _number(d_sep, "d_sep"),
+        d_comb=None if d_comb is None else _number(d_comb, "d_comb"),
         **kwargs,
     )
 

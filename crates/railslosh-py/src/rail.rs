@@ -16,8 +16,9 @@ use pyo3::types::PyDict;
 use rail_mbs::profile::{self, Profile, ProfileError, ProfileKind};
 use rail_mbs::track::{INCH, Side, Track, TrackError, TrackPoint};
 use rail_mbs::wheel_rail::{
-    ContactError, CreepModel, Creepages, FrictionMap, GaugeFaceLubrication, Material, PatchModel, RailGeometry,
-    RailPath, VerticalTarget, WheelGeometry, WheelRailContact, WheelState, kik_piotrowski, solve_vertical,
+    ContactError, CreepModel, Creepages, FrictionMap, GaugeFaceLubrication, Material, PatchCombination, PatchModel,
+    RailGeometry, RailPath, VerticalTarget, WheelGeometry, WheelRailContact, WheelState, kik_piotrowski,
+    solve_vertical,
 };
 use railslosh_cases::contact::ValidationError;
 
@@ -697,6 +698,37 @@ fn patch_model_of(name: &str, epsilon: Option<f64>, strips: Option<i64>) -> PyRe
     }
 }
 
+/// The patch rule `name` ("separate", or "contact": CONTACT's D_SEP/D_COMB rule with `a_sep`,
+/// `d_sep`, `d_comb`, default its program defaults π, 8 mm, 4 mm), which only "contact" takes.
+fn patch_combination_of(
+    name: &str,
+    a_sep: Option<f64>,
+    d_sep: Option<f64>,
+    d_comb: Option<f64>,
+) -> PyResult<PatchCombination> {
+    match name {
+        "separate" => {
+            for (field, value) in [("a_sep", a_sep), ("d_sep", d_sep), ("d_comb", d_comb)] {
+                if let Some(v) = value {
+                    return Err(invalid(field, v, "None with patch_combination \"separate\""));
+                }
+            }
+            Ok(PatchCombination::Separate)
+        }
+        "contact" => {
+            let mut rule = PatchCombination::contact();
+            if let PatchCombination::Contact { a_sep: a, d_sep: s, d_comb: c } = &mut rule {
+                *a = a_sep.unwrap_or(*a);
+                *s = d_sep.unwrap_or(*s);
+                *c = d_comb.unwrap_or(*c);
+            }
+            rule.validate().map_err(|e| PyValueError::new_err(e.to_string()))?;
+            Ok(rule)
+        }
+        other => Err(invalid("patch_combination", format!("{other:?}"), "one of \"separate\", \"contact\"")),
+    }
+}
+
 /// One wheel on its straight rail at the height carrying `load` (N, total vertical force
 /// on the wheel) or reaching `penetration` (m); see `railslosh.rail.contact`.
 #[pyfunction]
@@ -705,7 +737,8 @@ fn patch_model_of(name: &str, epsilon: Option<f64>, strips: Option<i64>) -> PyRe
                     roll=0.0, load=None, penetration=None, speed=0.0, lateral_velocity=0.0, yaw_rate=0.0,
                     axle_rate=None, creepages=None, creep_model="shen-hedrick-elkins", creep_parameters=None,
                     friction=0.3, friction_profile=None, young=2.1e11, poisson=0.3, scan_points=400,
-                    patch_model="hertz", kp_epsilon=None, kp_strips=None))]
+                    patch_model="hertz", kp_epsilon=None, kp_strips=None, patch_combination="separate",
+                    a_sep=None, d_sep=None, d_comb=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn wheel_rail_contact<'py>(
     py: Python<'py>,
@@ -739,6 +772,10 @@ pub fn wheel_rail_contact<'py>(
     patch_model: &str,
     kp_epsilon: Option<f64>,
     kp_strips: Option<i64>,
+    patch_combination: &str,
+    a_sep: Option<f64>,
+    d_sep: Option<f64>,
+    d_comb: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let side = side_of(side)?;
     let friction_map = match friction_profile {
@@ -790,6 +827,7 @@ pub fn wheel_rail_contact<'py>(
     };
     let model = creep_model_of(creep_model, creep_parameters)?;
     let patch = patch_model_of(patch_model, kp_epsilon, kp_strips)?;
+    let combination = patch_combination_of(patch_combination, a_sep, d_sep, d_comb)?;
     if let Some(o) = rail_offset {
         in_range("rail_offset", o, 0.3, 1.2, "m")?;
     }
@@ -828,6 +866,7 @@ pub fn wheel_rail_contact<'py>(
     contact.friction_map = friction_map;
     contact.creep_model = model;
     contact.patch_model = patch;
+    contact.settings.patch_combination = combination;
     contact.settings.scan_points = scan_points;
     let state = WheelState { lateral_shift, yaw, roll, speed, lateral_velocity, yaw_rate, axle_rate, creepages };
     let res = guarded(py, move || {
