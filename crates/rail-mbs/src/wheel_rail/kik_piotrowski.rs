@@ -289,6 +289,53 @@ fn kernel_nodes() -> &'static [(f64, f64)] {
     NODES.get_or_init(|| gauss_legendre_01(KERNEL_NODES))
 }
 
+/// The strips of a Kik–Piotrowski patch over its lobes and their sums
+/// ([`KpPatch::at_penetration`]: one lobe; [`KpPatch::combined`]: several).
+struct StripSums {
+    strips: Vec<PatchStrip>,
+    /// `Σ (π/2) x_l² Δy`.
+    num: f64,
+    /// For each centre `y_k`, `Σ` of the strips' half-space kernels about `y_k`.
+    den: Vec<f64>,
+    area: f64,
+    /// `Σ (π/2) x_l² Δy y`.
+    moment: f64,
+    x_max: f64,
+}
+
+impl StripSums {
+    /// `strips` strips shared among the `lobes` (intervals of `y`) in proportion to their widths
+    /// (at least one each), each with half-length `x_l = √((g_v − h(y))₊ / A(y))` at its centre,
+    /// and the kernels about each of `centres`.
+    fn over(sep: &impl SeparationFn, gv: f64, lobes: &[(f64, f64)], strips: usize, centres: &[f64]) -> Self {
+        let total: f64 = lobes.iter().map(|l| l.1 - l.0).sum();
+        let mut out = Vec::with_capacity(strips + lobes.len());
+        let (mut num, mut area, mut moment, mut x_max) = (0.0, 0.0, 0.0, 0.0f64);
+        let mut den = vec![0.0; centres.len()];
+        for &(a, b) in lobes {
+            let k = ((strips as f64 * (b - a) / total).round() as usize).max(1);
+            let width = (b - a) / k as f64;
+            for j in 0..k {
+                let y = a + (j as f64 + 0.5) * width;
+                let (h, ax) = sep.at(y);
+                let xl = ((gv - h).max(0.0) / ax).sqrt();
+                let q = std::f64::consts::FRAC_PI_2 * xl * xl * width;
+                num += q;
+                moment += q * y;
+                area += 2.0 * xl * width;
+                x_max = x_max.max(xl);
+                if xl > 0.0 {
+                    for (d, &yk) in den.iter_mut().zip(centres) {
+                        *d += strip_kernel(xl, y - 0.5 * width - yk, y + 0.5 * width - yk);
+                    }
+                }
+                out.push(PatchStrip { y, width, half_length: xl, peak_pressure: 0.0 });
+            }
+        }
+        Self { strips: out, num, den, area, moment, x_max }
+    }
+}
+
 /// `∫_{−c}^{c} √(c² − x²) ∫_{d1}^{d2} 1/√(x² + y²) dy dx` (the strip `d1 < y < d2` of
 /// constant half-length `c`).
 fn strip_kernel(c: f64, d1: f64, d2: f64) -> f64 {
@@ -379,23 +426,9 @@ impl KpPatch {
             end
         };
         let (y_lo, y_hi) = (edge(lo_end), edge(hi_end));
-        let width = (y_hi - y_lo) / strips as f64;
-        let mut out = Vec::with_capacity(strips);
-        let (mut num, mut den, mut area, mut moment, mut x_max) = (0.0, 0.0, 0.0, 0.0, 0.0f64);
-        for j in 0..strips {
-            let y = y_lo + (j as f64 + 0.5) * width;
-            let (h, a) = sep.at(y);
-            let xl = ((gv - h).max(0.0) / a).sqrt();
-            let q = std::f64::consts::FRAC_PI_2 * xl * xl * width;
-            num += q;
-            moment += q * y;
-            area += 2.0 * xl * width;
-            x_max = x_max.max(xl);
-            if xl > 0.0 {
-                den += strip_kernel(xl, y - 0.5 * width, y + 0.5 * width);
-            }
-            out.push(PatchStrip { y, width, half_length: xl, peak_pressure: 0.0 });
-        }
+        let StripSums { strips: mut out, num, den, area, moment, x_max } =
+            StripSums::over(sep, gv, &[(y_lo, y_hi)], strips, &[0.0]);
+        let den = den[0];
         let n = std::f64::consts::PI * e_star * delta * num / den;
         for s in &mut out {
             s.peak_pressure = n * s.half_length / num;
@@ -482,30 +515,9 @@ impl KpPatch {
             lobes.push((s, hi));
         }
         lobes.retain(|l| l.1 > l.0);
-        let total: f64 = lobes.iter().map(|l| l.1 - l.0).sum();
-        let mut out = Vec::with_capacity(strips + lobes.len());
-        let (mut num, mut area, mut moment, mut x_max) = (0.0, 0.0, 0.0, 0.0f64);
-        let mut den = vec![0.0; approach.len()];
-        for &(a, b) in &lobes {
-            let k = ((strips as f64 * (b - a) / total).round() as usize).max(1);
-            let width = (b - a) / k as f64;
-            for j in 0..k {
-                let y = a + (j as f64 + 0.5) * width;
-                let (h, ax) = sep.at(y);
-                let xl = ((gv - h).max(0.0) / ax).sqrt();
-                let q = std::f64::consts::FRAC_PI_2 * xl * xl * width;
-                num += q;
-                moment += q * y;
-                area += 2.0 * xl * width;
-                x_max = x_max.max(xl);
-                if xl > 0.0 {
-                    for (d, &(yk, _, _)) in den.iter_mut().zip(approach) {
-                        *d += strip_kernel(xl, y - 0.5 * width - yk, y + 0.5 * width - yk);
-                    }
-                }
-                out.push(PatchStrip { y, width, half_length: xl, peak_pressure: 0.0 });
-            }
-        }
+        let centres: Vec<f64> = approach.iter().map(|a| a.0).collect();
+        let StripSums { strips: mut out, num, den, area, moment, x_max } =
+            StripSums::over(sep, gv, &lobes, strips, &centres);
         let (mut rigid, mut elastic) = (0.0, 0.0);
         for (&(_, dk, wk), d) in approach.iter().zip(&den) {
             rigid += wk * dk;
