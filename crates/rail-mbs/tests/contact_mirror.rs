@@ -33,6 +33,18 @@ static FALLBACKS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsiz
 
 /// Total force on the wheel and moment about the wheelset centre (global), and the normal
 /// forces, sorted by contact-point lateral position.
+/// The wheel of a wheelset at lateral shift `y` with `yaw` and `roll`, rolling at 20 m/s with
+/// a little lateral and longitudinal creep, at the nominal height (r0 = 0.46 m).
+fn rolling_pose(y: f64, yaw: f64, roll: f64) -> WheelPose {
+    let (v, r0) = (20.0, 0.46);
+    WheelPose {
+        position: Vector3::new(5.0, y, r0),
+        rotation: rot(yaw, roll),
+        velocity: Vector3::new(v, 0.05, 0.0),
+        angular_velocity: Vector3::new(0.0, v / r0 * 1.001, 0.0),
+    }
+}
+
 fn resultant(c: &mut WheelRailContact, pose: &WheelPose) -> (Vector3<f64>, Vector3<f64>, Vec<f64>) {
     c.reset(); // a pure function of the pose: no previous solution as a starting guess
     let pts = c.evaluate(pose).unwrap();
@@ -50,7 +62,6 @@ fn resultant(c: &mut WheelRailContact, pose: &WheelPose) -> (Vector3<f64>, Vecto
 #[test]
 fn the_right_wheel_is_the_mirror_image_of_the_left_wheel_over_a_sweep_of_shifts() {
     let (mut left, mut right) = (contact(Side::Left), contact(Side::Right));
-    let (v, r0) = (20.0, 0.46);
     let mut worst: f64 = 0.0;
     let mut cases = 0;
     let mut counts = std::collections::BTreeMap::new();
@@ -58,12 +69,7 @@ fn the_right_wheel_is_the_mirror_image_of_the_left_wheel_over_a_sweep_of_shifts(
         for k in 0..=200 {
             // wheelset shift −10 … +10 mm (both flange contacts and the jumps towards them)
             let y = -0.010 + 1e-4 * k as f64;
-            let mut pose = WheelPose {
-                position: Vector3::new(5.0, y, r0),
-                rotation: rot(yaw, roll),
-                velocity: Vector3::new(v, 0.05, 0.0),
-                angular_velocity: Vector3::new(0.0, v / r0 * 1.001, 0.0),
-            };
+            let mut pose = rolling_pose(y, yaw, roll);
             // the left wheel carrying 60 kN (the mirrored right wheel is then at that height too)
             pose.position.z = height_for_load(&mut left, &pose, 6e4, 0.02);
             let (fl, ml, nl) = resultant(&mut left, &pose);
@@ -100,16 +106,10 @@ fn the_contact_of_a_pose_does_not_depend_on_the_search_history() {
     // ScanFallback; docs/validation.md, "Mirror symmetry and the search history").
     let mut warm = contact(Side::Right);
     let mut fresh = contact(Side::Right);
-    let (v, r0) = (20.0, 0.46);
     let (mut worst, mut fallbacks) = (0.0f64, 0);
     for k in 0..=200 {
         let y = 0.010 - 1e-4 * k as f64;
-        let mut pose = WheelPose {
-            position: Vector3::new(5.0, y, r0),
-            rotation: rot(0.0, 0.0),
-            velocity: Vector3::new(v, 0.05, 0.0),
-            angular_velocity: Vector3::new(0.0, v / r0 * 1.001, 0.0),
-        };
+        let mut pose = rolling_pose(y, 0.0, 0.0);
         pose.position.z = height_for_load(&mut warm, &pose, 6e4, 0.02); // leaves a history in `warm`
         let a = warm.evaluate(&pose).unwrap();
         fresh.reset();
@@ -275,17 +275,11 @@ fn the_mirror_images_hold_with_combined_patches() {
     let (mut left, mut right) = (contact(Side::Left), contact(Side::Right));
     left.settings.patch_combination = PatchCombination::contact();
     right.settings.patch_combination = PatchCombination::contact();
-    let (v, r0) = (20.0, 0.46);
     let (yaw, roll) = (-0.003, 0.0015);
     let (mut worst, mut combined): (f64, usize) = (0.0, 0);
     for k in 0..=200 {
         let y = -0.010 + 1e-4 * k as f64;
-        let mut pose = WheelPose {
-            position: Vector3::new(5.0, y, r0),
-            rotation: rot(yaw, roll),
-            velocity: Vector3::new(v, 0.05, 0.0),
-            angular_velocity: Vector3::new(0.0, v / r0 * 1.001, 0.0),
-        };
+        let mut pose = rolling_pose(y, yaw, roll);
         pose.position.z = height_for_load(&mut left, &pose, 6e4, 0.02);
         let (fl, ml, nl) = resultant(&mut left, &pose);
         let (fr, mr, nr) = resultant(&mut right, &pose.mirrored());
