@@ -223,9 +223,7 @@ pub fn solve_vertical(
 /// Kik–Piotrowski patch its equivalent ellipse; [`WheelRailContact::evaluate_with_creepages`]
 /// uses the patch itself).
 pub fn apply_creepages(contact: &WheelRailContact, points: &mut [ContactPoint], creepages: &Creepages) {
-    let (wm, rm) = (&contact.wheel_material, &contact.rail_material);
-    let g_mod = 2.0 / (1.0 / wm.shear_modulus() + 1.0 / rm.shear_modulus());
-    let nu = 0.5 * (wm.poisson + rm.poisson);
+    let (_, g_mod, nu) = contact.elastic_constants();
     for p in points {
         let (a, b) = p.semi_axes;
         p.creepages = *creepages;

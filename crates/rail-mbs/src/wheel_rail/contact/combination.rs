@@ -8,7 +8,7 @@ use nalgebra::Vector3;
 use super::{ContactGeometry, ContactPoint, WheelPose, WheelRailContact};
 use crate::wheel_rail::ContactError;
 use crate::wheel_rail::creep::{CreepForces, Creepages};
-use crate::wheel_rail::hertz::{HertzConstants, combined_modulus};
+use crate::wheel_rail::hertz::HertzConstants;
 use crate::wheel_rail::kik_piotrowski::{
     DEFAULT_EPSILON, DEFAULT_STRIPS, KpPatch, PatchModel, PatchSummary, SampledSeparation, SeparationFn,
 };
@@ -198,12 +198,11 @@ impl WheelRailContact {
             let (region, sep) = regions[k];
             part_weight(sep, g.penetration, region.lateral, (at(o) - at(g)).dot(&g.e2))
         };
-        let total = weight(0) + weight(1);
-        let w = [weight(0) / total, weight(1) / total];
+        let (w0, w1) = (weight(0), weight(1));
+        let total = w0 + w1;
+        let w = [w0 / total, w1 / total];
         let mu = w[0] * self.friction_at(&pair[0].params) + w[1] * self.friction_at(&pair[1].params);
-        let e_star = combined_modulus(&self.wheel_material, &self.rail_material);
-        let g_mod = 2.0 / (1.0 / self.wheel_material.shear_modulus() + 1.0 / self.rail_material.shear_modulus());
-        let nu = 0.5 * (self.wheel_material.poisson + self.rail_material.poisson);
+        let (e_star, g_mod, nu) = self.elastic_constants();
         let speed = pose.velocity.norm().max(self.settings.min_speed);
         // the patch in the frame of point d
         let in_frame =

@@ -1030,6 +1030,15 @@ impl WheelRailContact {
         self.friction_map.as_ref().map_or(self.friction, |m| m.mu(q[0], q[1]))
     }
 
+    /// The pair's elastic constants for the patch and creep laws: the combined plane-strain
+    /// modulus `E*` ([`combined_modulus`]), the combined shear modulus
+    /// `G = 2/(1/G_wheel + 1/G_rail)` and the mean Poisson ratio, (Pa, Pa, 1).
+    pub fn elastic_constants(&self) -> (f64, f64, f64) {
+        let (wm, rm) = (&self.wheel_material, &self.rail_material);
+        let g_mod = 2.0 / (1.0 / wm.shear_modulus() + 1.0 / rm.shear_modulus());
+        (combined_modulus(wm, rm), g_mod, 0.5 * (wm.poisson + rm.poisson))
+    }
+
     /// Contact points in contact (`δ > 0`) with normal and creep forces.
     pub fn evaluate(&mut self, pose: &WheelPose) -> Result<Vec<ContactPoint>, ContactError> {
         self.evaluate_cached(pose).map(<[ContactPoint]>::to_vec)
@@ -1115,9 +1124,7 @@ impl WheelRailContact {
         if let PatchModel::KikPiotrowski { epsilon, strips } = self.patch_model {
             return self.loaded_points_kp(pose, geoms, prescribed, epsilon, strips, out);
         }
-        let e_star = combined_modulus(&self.wheel_material, &self.rail_material);
-        let g_mod = 2.0 / (1.0 / self.wheel_material.shear_modulus() + 1.0 / self.rail_material.shear_modulus());
-        let nu = 0.5 * (self.wheel_material.poisson + self.rail_material.poisson);
+        let (e_star, g_mod, nu) = self.elastic_constants();
         for &g in geoms.iter().filter(|g| g.penetration > 0.0) {
             let kmin = self.settings.min_relative_curvature;
             let hertz =
@@ -1163,9 +1170,7 @@ impl WheelRailContact {
         out: &mut Vec<ContactPoint>,
     ) -> Result<(), ContactError> {
         self.patch_model.validate()?;
-        let e_star = combined_modulus(&self.wheel_material, &self.rail_material);
-        let g_mod = 2.0 / (1.0 / self.wheel_material.shear_modulus() + 1.0 / self.rail_material.shear_modulus());
-        let nu = 0.5 * (self.wheel_material.poisson + self.rail_material.poisson);
+        let (e_star, g_mod, nu) = self.elastic_constants();
         let kmin = self.settings.min_relative_curvature;
         let mut loaded: Vec<(ContactGeometry, KpPatch)> = Vec::new();
         for &g in geoms.iter().filter(|g| g.penetration > 0.0) {
