@@ -289,6 +289,20 @@ fn kernel_nodes() -> &'static [(f64, f64)] {
     NODES.get_or_init(|| gauss_legendre_01(KERNEL_NODES))
 }
 
+/// The edge of a patch between `inside` (`g > 0`) and `outside` (`g ≤ 0`): 60 bisections of the
+/// virtual interpenetration `g`.
+fn edge_between(g: &impl Fn(f64) -> f64, mut inside: f64, mut outside: f64) -> f64 {
+    for _ in 0..60 {
+        let mid = 0.5 * (inside + outside);
+        if g(mid) > 0.0 {
+            inside = mid;
+        } else {
+            outside = mid;
+        }
+    }
+    0.5 * (inside + outside)
+}
+
 /// The strips of a Kik–Piotrowski patch over its lobes and their sums
 /// ([`KpPatch::at_penetration`]: one lobe; [`KpPatch::combined`]: several).
 struct StripSums {
@@ -404,16 +418,7 @@ impl KpPatch {
                 let y = end * i as f64 / n as f64;
                 let h = sep.at(y).0;
                 if gv - h <= 0.0 {
-                    let (mut inside, mut outside) = (prev, y);
-                    for _ in 0..60 {
-                        let mid = 0.5 * (inside + outside);
-                        if g(mid) > 0.0 {
-                            inside = mid;
-                        } else {
-                            outside = mid;
-                        }
-                    }
-                    return 0.5 * (inside + outside);
+                    return edge_between(&g, prev, y);
                 }
                 if h > h_max {
                     (h_max, y_max) = (h, y);
@@ -487,14 +492,7 @@ impl KpPatch {
         let truncated = lo > span.0 || hi < span.1;
         // the lobes: intervals where g > 0, found on a grid of 400 steps per side of 0 (the
         // single patch's march) and refined by bisection
-        let crossing = |inside: f64, outside: f64| {
-            let (mut a, mut b) = (inside, outside);
-            for _ in 0..60 {
-                let m = 0.5 * (a + b);
-                if g(m) > 0.0 { a = m } else { b = m }
-            }
-            0.5 * (a + b)
-        };
+        let crossing = |inside: f64, outside: f64| edge_between(&g, inside, outside);
         let n = 400;
         let mut grid: Vec<f64> = (0..=n).rev().map(|i| lo * i as f64 / n as f64).collect();
         grid.extend((1..=n).map(|i| hi * i as f64 / n as f64));
