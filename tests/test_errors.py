@@ -202,3 +202,26 @@ def test_a_wrongly_typed_argument_of_a_compiled_function_is_named_in_the_message
     with pytest.raises(TypeError) as info:
         call()
     assert str(info.value).startswith(message), str(info.value)
+
+
+def test_the_run_kernels_take_one_train_dict_and_name_a_bad_key_in_it():
+    # issue 18: the three vehicle runs take one `train` dict (and a `cargo` dict), read key by
+    # key in the binding; a misspelt key is refused by name instead of silently left at its default
+    track = [[0.0] * 6, [3000.0] + [0.0] * 5]
+    train = {"track": track, "station": 300.0, "speed": 0.0, "t_end": 0.01}
+    with pytest.raises(ValueError, match=r"invalid `train` = stepp: expected keys among \[.*\"step\""):
+        _core.run_train({**train, "stepp": 1e-3})
+    with pytest.raises(ValueError, match=r"invalid `train.t_end` = missing"):
+        _core.run_train({k: v for k, v in train.items() if k != "t_end"})
+    with pytest.raises(TypeError, match=r"invalid `record_every` = 'fast': "):
+        _core.run_train({**train, "record_every": "fast"})
+    with pytest.raises(ValueError, match=r"invalid `cargo` = oill: expected keys among \[.*\"oil\""):
+        _core.run_fluid_train(train, {"fill": 0.5, "oill": "heavy"})
+    with pytest.raises(ValueError, match=r"invalid `cargo` = axis: expected keys among \[.*\"slosh_axis\""):
+        _core.run_equivalent_train(train, {"fill": 0.5, "axis": "lateral"})
+    with pytest.raises(ValueError, match=r"invalid `cargo.fill` = missing"):
+        _core.run_equivalent_train(train, {})
+    # left-out keys take the Rust scenario's defaults: 1 car, 1 ms steps (10 steps to 0.01 s)
+    res = _core.run_train(train)
+    assert res["stats"]["steps"] == 10
+    assert np.asarray(res["wheel_vertical"]).shape[1] == 4

@@ -2,7 +2,7 @@
 
 import os
 from collections.abc import Callable, Mapping, Sequence
-from typing import Any, final
+from typing import Any, TypedDict, final
 
 import numpy as np
 import numpy.typing as npt
@@ -339,94 +339,68 @@ def track_irregularity_defects(
 def track_psd(
     kind: str, channel_name: str, omega: npt.NDArray[np.float64], *, track_class: int | None = None
 ) -> npt.NDArray[np.float64]: ...
-def run_train(
-    track: list[list[float]],
-    *,
-    irregularity: dict[str, Any] | None = None,
-    cars: int = 1,
-    station: float = 50.0,
-    speed: float = 0.0,
-    t_end: float = 1.0,
-    step: float = 1e-3,
-    record_every: float = 0.01,
-    load_filter: str = "hat_mean",
-    drive_speed: float | None = None,
-    brake_times: list[float] | None = None,
-    brake_torques: list[float] | None = None,
-    brake_scope: str = "all",
-    lading_mass: float = 0.0,
-    lading_height: float = 0.0,
-    wheel_profile: str = "s1002",
-    wheelset_lateral_offset: float = 0.0,
-    coupler_stiffness: float | None = None,
-    coupler_damping: float | None = None,
-    car: dict[str, float | str] | None = None,
-    progress: _Progress | None = None,
-    stream: str | None = None,
-    friction_map: dict[str, Any] | None = None,
-) -> dict[str, Any]: ...
+
+class _TrainRequired(TypedDict):
+    track: list[list[float]]
+    station: float
+    speed: float
+    t_end: float
+
+class TrainArgs(_TrainRequired, total=False):
+    """The train of a vehicle run (``railslosh.vehicle._train_args`` builds it); a key left out or
+    ``None`` takes ``rail_mbs::vehicle::TrainScenario``'s default; an unknown key is a ValueError."""
+
+    irregularity: dict[str, Any] | None
+    cars: int
+    step: float
+    record_every: float
+    load_filter: str
+    snapshot_every: float
+    drive_speed: float | None
+    brake_times: list[float] | None
+    brake_torques: list[float] | None
+    brake_scope: str
+    brake_factors: list[float] | None
+    wheel_profile: str
+    wheelset_lateral_offset: float
+    coupler_stiffness: float | None
+    coupler_damping: float | None
+    car: dict[str, float | str] | None
+    friction_map: dict[str, Any] | None
+    lading_mass: float
+    lading_height: float
+
+class _FillRequired(TypedDict):
+    fill: float
+
+class FluidCargoArgs(_FillRequired, total=False):
+    """The ANCF cargo of ``run_fluid_train``; keys left out take ``FluidCargo::new``'s defaults."""
+
+    oil: str
+    fluid: Fluid | None
+    counts: tuple[int, int, int]
+    bulkheads: list[tuple[float, float]] | None
+    wall_damping_ratio: float
+    wall_adhesion: float
+    shear_stabilization: bool
+
+class EquivalentCargoArgs(_FillRequired, total=False):
+    """The equivalent-model cargo of ``run_equivalent_train``."""
+
+    oil: str
+    fluid: Fluid | None
+    bulkheads: list[tuple[float, float]] | None
+    slosh_axis: str
+
+def run_train(train: TrainArgs, *, progress: _Progress | None = None, stream: str | None = None) -> dict[str, Any]: ...
 def design_brake_torque(
     mass: float, v0: float = ..., v1: float = ..., duration: float = 10.0
 ) -> tuple[list[float], list[float]]: ...
 def run_fluid_train(
-    track: list[list[float]],
-    *,
-    irregularity: dict[str, Any] | None = None,
-    cars: int = 1,
-    station: float = 300.0,
-    speed: float = 0.0,
-    t_end: float = 1.0,
-    step: float = 4e-3,
-    record_every: float = 0.02,
-    load_filter: str = "hat_mean",
-    snapshot_every: float = 0.0,
-    drive_speed: float | None = None,
-    brake_times: list[float] | None = None,
-    brake_torques: list[float] | None = None,
-    brake_scope: str = "all",
-    brake_factors: list[float] | None = None,
-    oil: str = "light",
-    fluid: Fluid | None = None,
-    counts: tuple[int, int, int] = ...,
-    fill: float = 0.5,
-    bulkheads: list[tuple[float, float]] | None = None,
-    wheel_profile: str = "s1002",
-    car: dict[str, float | str] | None = None,
-    progress: _Progress | None = None,
-    stream: str | None = None,
-    wall_damping_ratio: float = ...,
-    wall_adhesion: float = 0.0,
-    friction_map: dict[str, Any] | None = None,
-    shear_stabilization: bool = False,
+    train: TrainArgs, cargo: FluidCargoArgs, *, progress: _Progress | None = None, stream: str | None = None
 ) -> dict[str, Any]: ...
 def run_equivalent_train(
-    track: list[list[float]],
-    *,
-    irregularity: dict[str, Any] | None = None,
-    cars: int = 1,
-    station: float = 50.0,
-    speed: float = 0.0,
-    t_end: float = 1.0,
-    step: float = 1e-3,
-    record_every: float = 0.01,
-    load_filter: str = "hat_mean",
-    drive_speed: float | None = None,
-    brake_times: list[float] | None = None,
-    brake_torques: list[float] | None = None,
-    brake_scope: str = "all",
-    brake_factors: list[float] | None = None,
-    oil: str = "light",
-    fluid: Fluid | None = None,
-    fill: float = 0.5,
-    bulkheads: list[tuple[float, float]] | None = None,
-    slosh_axis: str = "longitudinal",
-    lading_mass: float = 0.0,
-    lading_height: float = 0.0,
-    wheel_profile: str = "s1002",
-    car: dict[str, float | str] | None = None,
-    progress: _Progress | None = None,
-    stream: str | None = None,
-    friction_map: dict[str, Any] | None = None,
+    train: TrainArgs, cargo: EquivalentCargoArgs, *, progress: _Progress | None = None, stream: str | None = None
 ) -> dict[str, Any]: ...
 def equivalent_model(
     fill: float = 0.5,

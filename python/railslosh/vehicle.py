@@ -149,6 +149,73 @@ def _raise_on_error(res: dict[str, Any], what: str) -> dict[str, Any]:
     return res
 
 
+def _bulkheads(bulkheads: Sequence[tuple[float, float]] | None) -> list[tuple[float, float]] | None:
+    """Bulkheads ``[(x, thickness)]`` (tank frame, m) as the kernels take them."""
+    return None if bulkheads is None else [(float(x), float(t)) for x, t in bulkheads]
+
+
+def _train_args(
+    track: Any,
+    *,
+    irregularity: Irregularity | dict[str, Any] | None,
+    cars: int,
+    station: float,
+    speed: float,
+    t_end: float,
+    drive: bool | float,
+    brake: tuple[Sequence[float], Sequence[float]] | None,
+    brake_factors: Sequence[float] | None = None,
+    car: dict[str, float | str] | None,
+    friction_map: Mapping[str, Any] | None,
+    **settings: Any,
+) -> tuple[dict[str, Any], Irregularity | None]:
+    """The train of a vehicle run as the kernels take it (``railslosh._core.TrainArgs``), one form
+    for :func:`run`, :func:`run_fluid` and :func:`run_equivalent`, and the run's irregularity.
+    ``settings`` are the remaining ``TrainArgs`` keys, passed on as given (``step``,
+    ``record_every``, ``load_filter``, ``brake_scope``, ``wheel_profile``, ...)."""
+    drive_speed, times, torques = _drive_and_brake(drive, speed, brake)
+    samples, irr = _irregularity(irregularity, cars, station, car, _travel(speed, t_end))
+    train = dict(
+        track=_table(track),
+        irregularity=samples,
+        cars=cars,
+        station=station,
+        speed=speed,
+        t_end=t_end,
+        drive_speed=drive_speed,
+        brake_times=times,
+        brake_torques=torques,
+        brake_factors=None if brake_factors is None else list(map(float, brake_factors)),
+        car=car,
+        friction_map=None if friction_map is None else dict(friction_map),
+        **settings,
+    )
+    return train, irr
+
+
+def _run_train(
+    kernel: Any,
+    what: str,
+    train: dict[str, Any],
+    irr: Irregularity | None,
+    *cargo: dict[str, Any],
+    progress: ProgressArg,
+    stream: str | os.PathLike[str] | None,
+    **extra: Any,
+) -> dict[str, Any]:
+    """Runs ``kernel`` (``railslosh._core.run_train``, ``run_fluid_train`` or
+    ``run_equivalent_train``) on ``train`` and its cargo with a progress bar, adds the run's
+    ``load_filter``, ``extra`` entries and irregularity to the results, and raises
+    :class:`railslosh.slosh.SimulationError` (``what`` stopped at t = ...) on a failed run."""
+    with progress_callback(progress, "vehicle run") as on_progress:
+        res = dict(kernel(train, *cargo, progress=on_progress, stream=None if stream is None else os.fspath(stream)))
+    res["load_filter"] = train["load_filter"]
+    res.update(extra)
+    if irr is not None:
+        res["irregularity"] = irr
+    return _raise_on_error(res, what)
+
+
 def run(
     track: Any,
     *,
@@ -214,40 +281,29 @@ def run(
     Raises ``ValueError`` naming a bad field, and :class:`railslosh.slosh.SimulationError` (with
     ``.results`` up to the failure) when the run stops early.
     """
-    drive_speed, times, torques = _drive_and_brake(drive, speed, brake)
-    samples, irr = _irregularity(irregularity, cars, station, car, _travel(speed, t_end))
-    with progress_callback(progress, "vehicle run") as on_progress:
-        res = dict(
-            _core.run_train(
-                _table(track),
-                irregularity=samples,
-                cars=cars,
-                station=station,
-                speed=speed,
-                t_end=t_end,
-                step=step,
-                record_every=record_every,
-                load_filter=load_filter,
-                drive_speed=drive_speed,
-                brake_times=times,
-                brake_torques=torques,
-                brake_scope=brake_scope,
-                lading_mass=lading_mass,
-                lading_height=lading_height,
-                wheel_profile=wheel_profile,
-                wheelset_lateral_offset=wheelset_lateral_offset,
-                coupler_stiffness=coupler_stiffness,
-                coupler_damping=coupler_damping,
-                car=car,
-                progress=on_progress,
-                stream=None if stream is None else os.fspath(stream),
-                friction_map=None if friction_map is None else dict(friction_map),
-            )
-        )
-    res["load_filter"] = load_filter
-    if irr is not None:
-        res["irregularity"] = irr
-    return _raise_on_error(res, "vehicle run")
+    train, irr = _train_args(
+        track,
+        irregularity=irregularity,
+        cars=cars,
+        station=station,
+        speed=speed,
+        t_end=t_end,
+        drive=drive,
+        brake=brake,
+        car=car,
+        friction_map=friction_map,
+        step=step,
+        record_every=record_every,
+        load_filter=load_filter,
+        brake_scope=brake_scope,
+        lading_mass=lading_mass,
+        lading_height=lading_height,
+        wheel_profile=wheel_profile,
+        wheelset_lateral_offset=wheelset_lateral_offset,
+        coupler_stiffness=coupler_stiffness,
+        coupler_damping=coupler_damping,
+    )
+    return _run_train(_core.run_train, "vehicle run", train, irr, progress=progress, stream=stream)
 
 
 def design_brake_torque(
@@ -315,48 +371,47 @@ def run_fluid(
     fill = limits.check("fill", fill)
     wall_damping_ratio = limits.check("wall_damping_ratio", wall_damping_ratio)
     wall_adhesion = limits.check("wall_adhesion", wall_adhesion)
-    drive_speed, times, torques = _drive_and_brake(drive, speed, brake)
-    samples, irr = _irregularity(irregularity, cars, station, car, _travel(speed, t_end))
-    with progress_callback(progress, "vehicle run") as on_progress:
-        res = dict(
-            _core.run_fluid_train(
-                _table(track),
-                irregularity=samples,
-                cars=cars,
-                station=station,
-                speed=speed,
-                t_end=t_end,
-                step=step,
-                record_every=record_every,
-                load_filter=load_filter,
-                snapshot_every=snapshot_every,
-                drive_speed=drive_speed,
-                brake_times=times,
-                brake_torques=torques,
-                brake_scope=brake_scope,
-                brake_factors=None if brake_factors is None else list(map(float, brake_factors)),
-                oil=oil,
-                fluid=fluid,
-                counts=tuple(counts),
-                fill=fill,
-                bulkheads=None if bulkheads is None else [(float(x), float(t)) for x, t in bulkheads],
-                wheel_profile=wheel_profile,
-                car=car,
-                progress=on_progress,
-                stream=None if stream is None else os.fspath(stream),
-                friction_map=None if friction_map is None else dict(friction_map),
-                wall_damping_ratio=wall_damping_ratio,
-                wall_adhesion=wall_adhesion,
-                shear_stabilization=bool(shear_stabilization),
-            )
-        )
-    res["load_filter"] = load_filter
-    res["wall_damping_ratio"] = wall_damping_ratio
-    res["wall_adhesion"] = wall_adhesion
-    res["shear_stabilization"] = bool(shear_stabilization)
-    if irr is not None:
-        res["irregularity"] = irr
-    return _raise_on_error(res, "fluid vehicle run")
+    train, irr = _train_args(
+        track,
+        irregularity=irregularity,
+        cars=cars,
+        station=station,
+        speed=speed,
+        t_end=t_end,
+        drive=drive,
+        brake=brake,
+        brake_factors=brake_factors,
+        car=car,
+        friction_map=friction_map,
+        step=step,
+        record_every=record_every,
+        load_filter=load_filter,
+        snapshot_every=snapshot_every,
+        brake_scope=brake_scope,
+        wheel_profile=wheel_profile,
+    )
+    cargo = dict(
+        oil=oil,
+        fluid=fluid,
+        counts=tuple(counts),
+        fill=fill,
+        bulkheads=_bulkheads(bulkheads),
+        wall_damping_ratio=wall_damping_ratio,
+        wall_adhesion=wall_adhesion,
+        shear_stabilization=bool(shear_stabilization),
+    )
+    return _run_train(
+        _core.run_fluid_train,
+        "fluid vehicle run",
+        train,
+        irr,
+        cargo,
+        progress=progress,
+        stream=stream,
+        wall_damping_ratio=wall_damping_ratio,
+        wall_adhesion=wall_adhesion,
+        shear_stabilization=bool(shear_stabilization),
+    )
 
 
 SLOSH_AXES = ("longitudinal", "lateral")
@@ -383,7 +438,7 @@ def equivalent_model(
             fill,
             oil=oil,
             fluid=fluid,
-            bulkheads=None if bulkheads is None else [(float(x), float(t)) for x, t in bulkheads],
+            bulkheads=_bulkheads(bulkheads),
             slosh_axis=slosh_axis,
             car=car,
         )
@@ -430,43 +485,36 @@ def run_equivalent(
     if slosh_axis not in SLOSH_AXES:
         raise ValueError(f"invalid `slosh_axis` = {slosh_axis!r}: expected one of {', '.join(SLOSH_AXES)}")
     fill = limits.check("fill", fill)
-    drive_speed, times, torques = _drive_and_brake(drive, speed, brake)
-    samples, irr = _irregularity(irregularity, cars, station, car, _travel(speed, t_end))
-    with progress_callback(progress, "vehicle run") as on_progress:
-        res = dict(
-            _core.run_equivalent_train(
-                _table(track),
-                irregularity=samples,
-                cars=cars,
-                station=station,
-                speed=speed,
-                t_end=t_end,
-                step=step,
-                record_every=record_every,
-                load_filter=load_filter,
-                drive_speed=drive_speed,
-                brake_times=times,
-                brake_torques=torques,
-                brake_scope=brake_scope,
-                brake_factors=None if brake_factors is None else list(map(float, brake_factors)),
-                oil=oil,
-                fluid=fluid,
-                fill=fill,
-                bulkheads=None if bulkheads is None else [(float(x), float(t)) for x, t in bulkheads],
-                slosh_axis=slosh_axis,
-                lading_mass=lading_mass,
-                lading_height=lading_height,
-                wheel_profile=wheel_profile,
-                car=car,
-                progress=on_progress,
-                stream=None if stream is None else os.fspath(stream),
-                friction_map=None if friction_map is None else dict(friction_map),
-            )
-        )
-    res["load_filter"] = load_filter
-    if irr is not None:
-        res["irregularity"] = irr
-    return _raise_on_error(res, "equivalent-slosh vehicle run")
+    train, irr = _train_args(
+        track,
+        irregularity=irregularity,
+        cars=cars,
+        station=station,
+        speed=speed,
+        t_end=t_end,
+        drive=drive,
+        brake=brake,
+        brake_factors=brake_factors,
+        car=car,
+        friction_map=friction_map,
+        step=step,
+        record_every=record_every,
+        load_filter=load_filter,
+        brake_scope=brake_scope,
+        lading_mass=lading_mass,
+        lading_height=lading_height,
+        wheel_profile=wheel_profile,
+    )
+    cargo = dict(
+        oil=oil,
+        fluid=fluid,
+        fill=fill,
+        bulkheads=_bulkheads(bulkheads),
+        slosh_axis=slosh_axis,
+    )
+    return _run_train(
+        _core.run_equivalent_train, "equivalent-slosh vehicle run", train, irr, cargo, progress=progress, stream=stream
+    )
 
 
 def read_stream(path: str | os.PathLike[str]) -> dict[str, Any]:

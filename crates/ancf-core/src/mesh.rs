@@ -110,6 +110,16 @@ impl FluidMesh {
     }
 }
 
+/// The fill of a tank mesh, a liquid volume fraction in (0, 0.97]: above 0.97 the elements at
+/// the free surface's edge degenerate (Python's `railslosh.limits.FILL` keeps 0.03 to 0.97,
+/// below which the bottom row is a sliver).
+pub fn check_fill(fill: f64) -> Result<()> {
+    if !(fill.is_finite() && fill > 0.0 && fill <= 0.97) {
+        return Err(invalid("fill", fill, "a volume fraction in (0, 0.97]"));
+    }
+    Ok(())
+}
+
 fn check_count(field: &str, n: usize) -> Result<()> {
     if (1..=10_000).contains(&n) { Ok(()) } else { Err(invalid(field, n, "an integer in [1, 10000]")) }
 }
@@ -416,9 +426,7 @@ impl CylinderTankSpec {
         if !(self.head_depth.is_finite() && self.head_depth >= 0.0 && self.head_depth <= 2.0 * self.radius) {
             return Err(invalid("head_depth", self.head_depth, "a number in [0, 2·radius]"));
         }
-        if !(self.fill.is_finite() && self.fill > 0.0 && self.fill <= 0.97) {
-            return Err(invalid("fill", self.fill, "a volume fraction in (0, 0.97]"));
-        }
+        check_fill(self.fill)?;
         check_count("n_length", self.n_length)?;
         check_count("n_width", self.n_width)?;
         check_count("n_height", self.n_height)?;
@@ -529,9 +537,7 @@ impl EllipticCylinderSpec {
         check_positive("length", self.length)?;
         check_positive("semi_axis_y", self.semi_axis_y)?;
         check_positive("semi_axis_z", self.semi_axis_z)?;
-        if !(self.fill.is_finite() && self.fill > 0.0 && self.fill <= 0.97) {
-            return Err(invalid("fill", self.fill, "a volume fraction in (0, 0.97]"));
-        }
+        check_fill(self.fill)?;
         check_count("n_length", self.n_length)?;
         check_count("n_width", self.n_width)?;
         check_count("n_height", self.n_height)

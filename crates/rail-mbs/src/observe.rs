@@ -1,5 +1,6 @@
-//! Progress reports and the observer of a run (a progress bar, a stop button): one type for
-//! every run kind (slosh, vehicle, co-simulation participant).
+//! What every run kind shares (slosh, vehicle, co-simulation participant): its progress
+//! reports, the observer of a run (a progress bar, a stop button), the results stream a run
+//! writes its samples to as it goes, and the failure that carries what a stopped run computed.
 
 use crate::integrator::{Hht, IntegratorError};
 
@@ -39,4 +40,22 @@ pub type Observer<'a> = &'a mut dyn FnMut(&Progress) -> bool;
 /// The error of a run stopped by its [`Observer`].
 pub fn stopped_by_observer(t: f64) -> IntegratorError {
     IntegratorError::InvalidSystem { what: format!("run stopped by its progress observer at t = {t} s") }
+}
+
+/// Receives every recorded sample as a flat row (the record's `row` layout, e.g.
+/// `TrainRecord::row`, extended by `FluidTrainRecord::row` for fluid runs) as soon as it is
+/// recorded: a results stream that an interrupted run cannot lose (e.g. a
+/// [`crate::integrator::Journal`]).
+pub type SampleSink<'a> = &'a mut dyn FnMut(&[f64]) -> Result<(), IntegratorError>;
+
+/// A run that stopped early: why (time, place, quantity and limit in `error`) and everything
+/// recorded up to the last accepted step. The one failure type of every run kind; its record
+/// type names the kind (`TrainFailure`, `FluidTrainFailure`, `EquivalentTrainFailure`,
+/// `SloshFailure` are this type for the vehicle runs' and the slosh run's records).
+#[derive(Debug)]
+pub struct RunFailure<R> {
+    /// Why it stopped.
+    pub error: IntegratorError,
+    /// Results up to the failure.
+    pub record: R,
 }

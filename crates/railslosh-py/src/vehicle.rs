@@ -12,10 +12,9 @@ use rail_mbs::mbs::{SpeedProfile, Table};
 use rail_mbs::profile::aar1b_wheel_approx;
 use rail_mbs::track::{Track, TrackPoint};
 use rail_mbs::vehicle::{
-    BrakeScope, EquivalentCargo, EquivalentModel, EquivalentTrainRecord, FluidCargo, FluidTrainRecord, LoadFilter,
-    Observer, SampleSink, SloshAxis, TankCarParams, TrainRecord, TrainScenario, TruckModel,
-    run_equivalent_train_streamed as rust_run_equivalent_train, run_fluid_train_streamed as rust_run_fluid_train,
-    run_train_streamed as rust_run_train,
+    BrakeScope, Cargo, EquivalentCargo, EquivalentModel, EquivalentTrainRecord, FluidCargo, FluidTrainRecord,
+    LoadFilter, Observer, RigidCargo, SampleSink, SloshAxis, TankCarParams, TrainRecord, TrainScenario, TruckModel,
+    run_vehicle,
 };
 
 use crate::{PyProgress, compute};
@@ -283,67 +282,136 @@ fn brake_of(times: Option<Vec<f64>>, torques: Option<Vec<f64>>, scope: &str) -> 
     }
 }
 
-/// Runs a train of rigid-lading tank cars on a track given as rows
-/// `(s, curvature, superelevation, grade, cant_right, cant_left)` (SI). Returns a dict
-/// of arrays; on a failed run the dict has an `error` entry and the results so far.
-#[pyfunction]
-#[pyo3(signature = (
-    track, *, irregularity=None, cars=1, station=50.0, speed=0.0, t_end=1.0, step=1e-3, record_every=0.01, load_filter="hat_mean",
-    drive_speed=None, brake_times=None, brake_torques=None, brake_scope="all",
-    lading_mass=0.0, lading_height=0.0, wheel_profile="s1002", wheelset_lateral_offset=0.0,
-    coupler_stiffness=None, coupler_damping=None, car=None, progress=None, stream=None, friction_map=None
-))]
-#[allow(clippy::too_many_arguments)]
-pub fn run_train<'py>(
-    py: Python<'py>,
-    track: Vec<Vec<f64>>,
-    irregularity: Option<&Bound<'py, PyDict>>,
-    cars: usize,
-    station: f64,
-    speed: f64,
-    t_end: f64,
-    step: f64,
-    record_every: f64,
-    load_filter: &str,
-    drive_speed: Option<f64>,
-    brake_times: Option<Vec<f64>>,
-    brake_torques: Option<Vec<f64>>,
-    brake_scope: &str,
-    lading_mass: f64,
-    lading_height: f64,
-    wheel_profile: &str,
-    wheelset_lateral_offset: f64,
-    coupler_stiffness: Option<f64>,
-    coupler_damping: Option<f64>,
-    car: Option<&Bound<'py, PyDict>>,
-    progress: Option<Py<PyAny>>,
-    stream: Option<std::path::PathBuf>,
-    friction_map: Option<&Bound<'py, PyDict>>,
-) -> PyResult<Bound<'py, PyDict>> {
-    let mut params = car_params(car, wheel_profile)?;
-    params.contact.friction_map = friction_map_of(friction_map, &params.contact.rail_profile)?;
+/// The keyword arguments of a run held in one dict (`train`, `cargo`), read key by key: a value
+/// of the wrong type is a `TypeError` naming its key and value, a missing required key or an
+/// unknown one a `ValueError` naming it, and `None` or a left-out key means the default.
+struct Args<'a, 'py> {
+    d: &'a Bound<'py, PyDict>,
+    what: &'static str,
+    read: Vec<&'static str>,
+}
+
+impl<'a, 'py> Args<'a, 'py> {
+    fn new(what: &'static str, d: &'a Bound<'py, PyDict>) -> Self {
+        Self { d, what, read: Vec::new() }
+    }
+
+    /// The value of `key`, `None` when it is left out or `None`.
+    fn opt<T: for<'b> FromPyObject<'b, 'py>>(&mut self, key: &'static str) -> PyResult<Option<T>>
+    where
+        for<'b> <T as FromPyObject<'b, 'py>>::Error: Into<PyErr>,
+    {
+        self.read.push(key);
+        let Some(v) = self.d.get_item(key)? else { return Ok(None) };
+        if v.is_none() {
+            return Ok(None);
+        }
+        match v.extract::<T>() {
+            Ok(x) => Ok(Some(x)),
+            Err(e) => {
+                let e: PyErr = e.into();
+                let shown = v.repr().map_or_else(|_| "?".to_string(), |r| r.to_string());
+                Err(pyo3::exceptions::PyTypeError::new_err(format!("invalid `{key}` = {shown}: {}", e.value(v.py()))))
+            }
+        }
+    }
+
+    /// The value of `key`, which must be given.
+    fn req<T: for<'b> FromPyObject<'b, 'py>>(&mut self, key: &'static str) -> PyResult<T>
+    where
+        for<'b> <T as FromPyObject<'b, 'py>>::Error: Into<PyErr>,
+    {
+        let what = self.what;
+        self.opt(key)?.ok_or_else(|| crate::to_py(invalid(&format!("{what}.{key}"), "missing", "a value")))
+    }
+
+    /// Checks that every key of the dict was read: a misspelt one is an error, not a setting
+    /// silently left at its default.
+    fn finish(self) -> PyResult<()> {
+        for k in self.d.keys() {
+            let k: String = k.extract()?;
+            if !self.read.contains(&k.as_str()) {
+                return Err(crate::to_py(invalid(self.what, &k, &format!("keys among {:?}", self.read))));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The scenario of a vehicle run from its `train` dict, the one form the three run functions
+/// take (the stubs' `railslosh._core.TrainArgs`, built by `railslosh.vehicle`'s one
+/// `_train_args`): the car with its overrides, wheel profile, friction map and rigid lading,
+/// the track (rows `(s, curvature, superelevation, grade, cant_right, cant_left)`, SI) with its
+/// irregularity, and the run settings. Keys left out take [`TrainScenario::single`]'s defaults.
+fn train_scenario(d: &Bound<'_, PyDict>) -> PyResult<TrainScenario> {
+    let mut a = Args::new("train", d);
+    let car: Option<Bound<'_, PyDict>> = a.opt("car")?;
+    let wheel_profile: Option<String> = a.opt("wheel_profile")?;
+    let mut params = car_params(car.as_ref(), wheel_profile.as_deref().unwrap_or("s1002"))?;
+    let friction_map: Option<Bound<'_, PyDict>> = a.opt("friction_map")?;
+    params.contact.friction_map = friction_map_of(friction_map.as_ref(), &params.contact.rail_profile)?;
+    let lading_mass = a.opt("lading_mass")?.unwrap_or(0.0);
+    let lading_height = a.opt("lading_height")?.unwrap_or(0.0);
     if lading_mass != 0.0 {
         params.lading = Some((lading_mass, lading_height));
     }
-    let brake = brake_of(brake_times, brake_torques, brake_scope)?;
-    let track = track_of(track, irregularity)?;
-    let mut sc = TrainScenario::single(params, track, station, speed, t_end);
-    sc.cars = cars;
-    sc.step = step;
-    sc.record_every = record_every;
-    sc.load_filter = LoadFilter::parse(load_filter).map_err(crate::to_py)?;
-    sc.drive = drive_speed.map(SpeedProfile::Constant);
+    let scope: Option<String> = a.opt("brake_scope")?;
+    let brake = brake_of(a.opt("brake_times")?, a.opt("brake_torques")?, scope.as_deref().unwrap_or("all"))?;
+    let irregularity: Option<Bound<'_, PyDict>> = a.opt("irregularity")?;
+    let track = track_of(a.req("track")?, irregularity.as_ref())?;
+    let mut sc = TrainScenario::single(params, track, a.req("station")?, a.req("speed")?, a.req("t_end")?);
+    sc.cars = a.opt("cars")?.unwrap_or(sc.cars);
+    sc.step = a.opt("step")?.unwrap_or(sc.step);
+    sc.record_every = a.opt("record_every")?.unwrap_or(sc.record_every);
+    if let Some(f) = a.opt::<String>("load_filter")? {
+        sc.load_filter = LoadFilter::parse(&f).map_err(crate::to_py)?;
+    }
+    sc.snapshot_every = a.opt("snapshot_every")?.unwrap_or(sc.snapshot_every);
+    sc.drive = a.opt("drive_speed")?.map(SpeedProfile::Constant);
     sc.brake = brake;
-    sc.wheelset_lateral_offset = wheelset_lateral_offset;
-    sc.coupler = (coupler_stiffness, coupler_damping);
-    let columns = rail_mbs::vehicle::TrainRecord::columns(4 * sc.cars, sc.cars.saturating_sub(1), sc.cars);
+    sc.brake_factors = a.opt("brake_factors")?.unwrap_or_default();
+    sc.wheelset_lateral_offset = a.opt("wheelset_lateral_offset")?.unwrap_or(sc.wheelset_lateral_offset);
+    sc.coupler = (a.opt("coupler_stiffness")?, a.opt("coupler_damping")?);
+    a.finish()?;
+    Ok(sc)
+}
+
+/// Runs `sc` carrying `cargo` with the GIL released ([`rail_mbs::vehicle::run_vehicle`]):
+/// `progress` called as it goes, every recorded sample appended to the `stream` file. Returns
+/// the record as a dict (`to_dict`), with an `error` entry when the run stopped early.
+fn run_cargo<'py, C: Cargo + Send + Sync>(
+    py: Python<'py>,
+    sc: TrainScenario,
+    cargo: C,
+    (progress, stream): (Option<Py<PyAny>>, Option<std::path::PathBuf>),
+    to_dict: impl Fn(Python<'py>, &C::Record) -> PyResult<Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyDict>>
+where
+    C::Record: Send,
+{
+    let columns = compute(py, || cargo.columns(&sc))?;
     let run = move |obs: Observer<'_>, sink: SampleSink<'_>| {
-        Ok(match rust_run_train(&sc, obs, Some(sink))? {
+        Ok(match run_vehicle(&sc, &cargo, obs, Some(sink))? {
             Ok(r) => (r, None),
             Err(f) => (f.record, Some(f.error.to_string())),
         })
     };
-    run_recorded(py, progress, stream, columns, run, |py, r| record_dict(py, r))
+    run_recorded(py, progress, stream, columns, run, to_dict)
+}
+
+/// Runs a train of rigid-lading tank cars (`train`: a `TrainArgs` dict; `lading_mass`,
+/// `lading_height` in it give the rigid lading). Returns a dict of arrays; on a failed run the
+/// dict has an `error` entry and the results so far.
+#[pyfunction]
+#[pyo3(signature = (train, *, progress=None, stream=None))]
+pub fn run_train<'py>(
+    py: Python<'py>,
+    train: &Bound<'py, PyDict>,
+    progress: Option<Py<PyAny>>,
+    stream: Option<std::path::PathBuf>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let sc = train_scenario(train)?;
+    run_cargo(py, sc, RigidCargo, (progress, stream), |py, r| record_dict(py, r))
 }
 
 /// Runs a train with the GIL released, `progress` called as it goes and every recorded
@@ -441,88 +509,55 @@ pub fn design_brake_torque(mass: f64, v0: f64, v1: f64, duration: f64) -> PyResu
     Ok((t.x, t.y))
 }
 
-/// Runs a train whose tanks carry an ANCF fluid (monolithic with the cars). `oil` names a
-/// liquid of seed 000 Table 2 (or water) unless `fluid` (a `railslosh.Fluid`) is given.
-/// Returns the `run_train` arrays plus the oil centre of mass (tank and global frames),
-/// the fluid load on each tank, volume errors and mesh snapshots. `wall_damping_ratio`: the
-/// damping ratio of the liquid column on the penalty wall (`WallContactLaw::with_damping_ratio`);
-/// `wall_adhesion`: the suction an adhesive wall holds on the wetted liquid, in units of ρ g H
-/// (`WallContactLaw::with_adhesion`); `shear_stabilization`: give a fluid without its own the
-/// recommended shear stabilization (`FluidCargo::shear_stabilization`).
+/// The ANCF cargo of a fluid run from its `cargo` dict (the stubs'
+/// `railslosh._core.FluidCargoArgs`) on the car `car`: `oil` names a liquid of seed 000 Table 2
+/// (or water) unless `fluid` (a `railslosh.Fluid`) is given; `counts` elements along the length,
+/// width and height; `fill` the volume fraction (required); `bulkheads` `[(x, thickness)]`;
+/// `wall_damping_ratio` the damping ratio of the liquid column on the penalty wall
+/// (`WallContactLaw::with_damping_ratio`); `wall_adhesion` the suction an adhesive wall holds, in
+/// units of ρ g H (`WallContactLaw::with_adhesion`); `shear_stabilization` gives a fluid without
+/// its own the recommended one (`FluidCargo::shear_stabilization`). Keys left out take
+/// `FluidCargo::new`'s defaults (light crude, 6 × 4 × 2 elements).
+fn fluid_cargo(d: &Bound<'_, PyDict>, car: &TankCarParams) -> PyResult<FluidCargo> {
+    let mut a = Args::new("cargo", d);
+    let counts: (usize, usize, usize) = a.opt("counts")?.unwrap_or((6, 4, 2));
+    let fill: f64 = a.req("fill")?;
+    ancf_core::mesh::check_fill(fill).map_err(crate::to_py)?;
+    let depth = 2.0 * car.tank_radius * fill;
+    let oil: Option<String> = a.opt("oil")?;
+    let fluid = match a.opt::<Bound<'_, crate::PyFluid>>("fluid")? {
+        Some(f) => f.get().inner,
+        None => oil_of(oil.as_deref().unwrap_or("light"))?
+            .fluid(depth, depth / counts.2.max(1) as f64)
+            .map_err(crate::to_py)?,
+    };
+    let bulkheads = a.opt("bulkheads")?.unwrap_or_default();
+    let mut cargo = FluidCargo::new(fluid, [counts.0, counts.1, counts.2], fill, bulkheads);
+    cargo.wall_damping_ratio = a.opt("wall_damping_ratio")?.unwrap_or(cargo.wall_damping_ratio);
+    cargo.wall_adhesion = a.opt("wall_adhesion")?.unwrap_or(cargo.wall_adhesion);
+    cargo.shear_stabilization = a.opt("shear_stabilization")?.unwrap_or(cargo.shear_stabilization);
+    a.finish()?;
+    Ok(cargo)
+}
+
+/// Runs a train whose tanks carry an ANCF fluid, monolithic with the cars (`train`: a
+/// `TrainArgs` dict, `cargo`: a `FluidCargoArgs` dict), on the integrator settings of fluid
+/// trains (`TrainScenario::fluid_hht`). Returns the `run_train` arrays plus the oil centre of
+/// mass (tank and global frames), the fluid load on each tank, volume errors, the run-time
+/// invariants and mesh snapshots.
 #[pyfunction]
-#[pyo3(signature = (
-    track, *, irregularity=None, cars=1, station=300.0, speed=0.0, t_end=1.0, step=4e-3, record_every=0.02, load_filter="hat_mean", snapshot_every=0.0,
-    drive_speed=None, brake_times=None, brake_torques=None, brake_scope="all", brake_factors=None,
-    oil="light", fluid=None, counts=(6, 4, 2), fill=0.5, bulkheads=None, wheel_profile="s1002", car=None,
-    progress=None, stream=None, wall_damping_ratio=ancf_core::contact::WALL_DAMPING_RATIO, wall_adhesion=0.0,
-    friction_map=None, shear_stabilization=false
-))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (train, cargo, *, progress=None, stream=None))]
 pub fn run_fluid_train<'py>(
     py: Python<'py>,
-    track: Vec<Vec<f64>>,
-    irregularity: Option<&Bound<'py, PyDict>>,
-    cars: usize,
-    station: f64,
-    speed: f64,
-    t_end: f64,
-    step: f64,
-    record_every: f64,
-    load_filter: &str,
-    snapshot_every: f64,
-    drive_speed: Option<f64>,
-    brake_times: Option<Vec<f64>>,
-    brake_torques: Option<Vec<f64>>,
-    brake_scope: &str,
-    brake_factors: Option<Vec<f64>>,
-    oil: &str,
-    fluid: Option<Bound<'py, crate::PyFluid>>,
-    counts: (usize, usize, usize),
-    fill: f64,
-    bulkheads: Option<Vec<(f64, f64)>>,
-    wheel_profile: &str,
-    car: Option<&Bound<'py, PyDict>>,
+    train: &Bound<'py, PyDict>,
+    cargo: &Bound<'py, PyDict>,
     progress: Option<Py<PyAny>>,
     stream: Option<std::path::PathBuf>,
-    wall_damping_ratio: f64,
-    wall_adhesion: f64,
-    friction_map: Option<&Bound<'py, PyDict>>,
-    shear_stabilization: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let mut params = car_params(car, wheel_profile)?;
-    params.contact.friction_map = friction_map_of(friction_map, &params.contact.rail_profile)?;
-    let brake = brake_of(brake_times, brake_torques, brake_scope)?;
-    if !(fill > 0.05 && fill < 0.95) {
-        return Err(crate::to_py(invalid("fill", fill, "(0.05, 0.95)")));
-    }
-    let depth = 2.0 * params.tank_radius * fill;
-    let fluid = match fluid {
-        Some(f) => f.get().inner,
-        None => oil_of(oil)?.fluid(depth, depth / counts.2.max(1) as f64).map_err(crate::to_py)?,
-    };
-    let mut cargo = FluidCargo::new(fluid, [counts.0, counts.1, counts.2], fill, bulkheads.unwrap_or_default());
-    cargo.wall_damping_ratio = wall_damping_ratio;
-    cargo.wall_adhesion = wall_adhesion;
-    cargo.shear_stabilization = shear_stabilization;
-    let track = track_of(track, irregularity)?;
-    let mut sc = TrainScenario::single(params, track, station, speed, t_end);
-    sc.cars = cars;
-    sc.step = step;
-    sc.record_every = record_every;
-    sc.load_filter = LoadFilter::parse(load_filter).map_err(crate::to_py)?;
-    sc.snapshot_every = snapshot_every;
-    sc.drive = drive_speed.map(SpeedProfile::Constant);
-    sc.brake = brake;
-    sc.brake_factors = brake_factors.unwrap_or_default();
-    sc.hht.refresh_rate = 0.5;
-    let columns = rail_mbs::vehicle::FluidTrainRecord::columns(4 * sc.cars, sc.cars.saturating_sub(1), sc.cars);
-    let run = move |obs: Observer<'_>, sink: SampleSink<'_>| {
-        Ok(match rust_run_fluid_train(&sc, &cargo, obs, Some(sink))? {
-            Ok(r) => (r, None),
-            Err(f) => (f.record, Some(f.error.to_string())),
-        })
-    };
-    run_recorded(py, progress, stream, columns, run, |py, r| fluid_record_dict(py, r))
+    let mut sc = train_scenario(train)?;
+    sc.hht = TrainScenario::fluid_hht();
+    let cargo = fluid_cargo(cargo, &sc.car)?;
+    run_cargo(py, sc, cargo, (progress, stream), |py, r| fluid_record_dict(py, r))
 }
 
 fn slosh_axis_of(name: &str) -> PyResult<SloshAxis> {
@@ -650,72 +685,32 @@ fn equivalent_record_dict<'py>(py: Python<'py>, r: &EquivalentTrainRecord) -> Py
 }
 
 /// Runs a train whose tanks carry the equivalent spring–mass / pendulum model of their
-/// liquid (`rail_mbs::vehicle::equivalent`): one slosh mass per compartment along
-/// `slosh_axis` (`"longitudinal"` or `"lateral"`). Returns the `run_train` arrays plus the
-/// liquid centre of mass in the tank frame, the slosh displacements and the model.
+/// liquid (`rail_mbs::vehicle::equivalent`; `train`: a `TrainArgs` dict, `cargo`: an
+/// `EquivalentCargoArgs` dict): one slosh mass per compartment along the slosh axis. Returns
+/// the `run_train` arrays plus the liquid centre of mass in the tank frame, the slosh
+/// displacements and the model.
 #[pyfunction]
-#[pyo3(signature = (
-    track, *, irregularity=None, cars=1, station=50.0, speed=0.0, t_end=1.0, step=1e-3, record_every=0.01, load_filter="hat_mean",
-    drive_speed=None, brake_times=None, brake_torques=None, brake_scope="all", brake_factors=None,
-    oil="light", fluid=None, fill=0.5, bulkheads=None, slosh_axis="longitudinal",
-    lading_mass=0.0, lading_height=0.0, wheel_profile="s1002", car=None, progress=None, stream=None,
-    friction_map=None
-))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (train, cargo, *, progress=None, stream=None))]
 pub fn run_equivalent_train<'py>(
     py: Python<'py>,
-    track: Vec<Vec<f64>>,
-    irregularity: Option<&Bound<'py, PyDict>>,
-    cars: usize,
-    station: f64,
-    speed: f64,
-    t_end: f64,
-    step: f64,
-    record_every: f64,
-    load_filter: &str,
-    drive_speed: Option<f64>,
-    brake_times: Option<Vec<f64>>,
-    brake_torques: Option<Vec<f64>>,
-    brake_scope: &str,
-    brake_factors: Option<Vec<f64>>,
-    oil: &str,
-    fluid: Option<Bound<'py, crate::PyFluid>>,
-    fill: f64,
-    bulkheads: Option<Vec<(f64, f64)>>,
-    slosh_axis: &str,
-    lading_mass: f64,
-    lading_height: f64,
-    wheel_profile: &str,
-    car: Option<&Bound<'py, PyDict>>,
+    train: &Bound<'py, PyDict>,
+    cargo: &Bound<'py, PyDict>,
     progress: Option<Py<PyAny>>,
     stream: Option<std::path::PathBuf>,
-    friction_map: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let mut params = car_params(car, wheel_profile)?;
-    params.contact.friction_map = friction_map_of(friction_map, &params.contact.rail_profile)?;
-    if lading_mass != 0.0 {
-        params.lading = Some((lading_mass, lading_height));
-    }
-    let cargo = equivalent_cargo(oil, fluid, fill, bulkheads, slosh_axis)?;
-    let modes = compute(py, || cargo.model(&params, rail_mbs::track::GRAVITY))?.modes.len();
-    let brake = brake_of(brake_times, brake_torques, brake_scope)?;
-    let track = track_of(track, irregularity)?;
-    let mut sc = TrainScenario::single(params, track, station, speed, t_end);
-    sc.cars = cars;
-    sc.step = step;
-    sc.record_every = record_every;
-    sc.load_filter = LoadFilter::parse(load_filter).map_err(crate::to_py)?;
-    sc.drive = drive_speed.map(SpeedProfile::Constant);
-    sc.brake = brake;
-    sc.brake_factors = brake_factors.unwrap_or_default();
-    let columns = EquivalentTrainRecord::columns(4 * sc.cars, sc.cars.saturating_sub(1), sc.cars, modes);
-    let run = move |obs: Observer<'_>, sink: SampleSink<'_>| {
-        Ok(match rust_run_equivalent_train(&sc, &cargo, obs, Some(sink))? {
-            Ok(r) => (r, None),
-            Err(f) => (f.record, Some(f.error.to_string())),
-        })
-    };
-    run_recorded(py, progress, stream, columns, run, |py, r| equivalent_record_dict(py, r))
+    let sc = train_scenario(train)?;
+    // The stubs' `railslosh._core.EquivalentCargoArgs`: as `equivalent_model` takes them.
+    let mut a = Args::new("cargo", cargo);
+    let (oil, slosh_axis): (Option<String>, Option<String>) = (a.opt("oil")?, a.opt("slosh_axis")?);
+    let cargo = equivalent_cargo(
+        oil.as_deref().unwrap_or("light"),
+        a.opt("fluid")?,
+        a.req("fill")?,
+        a.opt("bulkheads")?,
+        slosh_axis.as_deref().unwrap_or("longitudinal"),
+    )?;
+    a.finish()?;
+    run_cargo(py, sc, cargo, (progress, stream), |py, r| equivalent_record_dict(py, r))
 }
 
 /// Registers the vehicle functions.

@@ -23,7 +23,7 @@ use crate::integrator::{
     Checkpoint, CheckpointFile, Explicit, ExplicitParams, Hht, HhtParams, IntegratorError, Journal, Stats,
 };
 use crate::invariants::{EnergySample, InvariantMonitor, Margins};
-use crate::observe::{Observer, Progress};
+use crate::observe::{Observer, Progress, RunFailure};
 
 /// Time series recorded by a slosh run. Loads are the force and moment the fluid exerts on
 /// the tank (through wall and bulkhead contact), moments about the tank origin.
@@ -265,16 +265,10 @@ pub struct SloshRun {
     next_snapshot: f64,
 }
 
-/// A failed run: the error and everything recorded up to it.
-#[derive(Debug)]
-pub struct SloshFailure {
-    /// What went wrong, and when.
-    pub error: IntegratorError,
-    /// The record up to the last accepted step.
-    pub record: SloshRecord,
-}
+/// A failed run: the error and everything recorded up to the last accepted step.
+pub type SloshFailure = RunFailure<SloshRecord>;
 
-impl std::fmt::Display for SloshFailure {
+impl std::fmt::Display for RunFailure<SloshRecord> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "slosh run failed after {} recorded steps: {}", self.record.t.len(), self.error)
     }

@@ -40,15 +40,14 @@ mod tank_car;
 
 pub use equivalent::{
     EquivalentCargo, EquivalentModel, EquivalentTrainFailure, EquivalentTrainRecord, SloshAxis, build_equivalent_train,
-    run_equivalent_train, run_equivalent_train_streamed,
+    run_equivalent_train,
 };
 pub use fluid::{
     FluidCargo, FluidTrainFailure, FluidTrainRecord, FluidVehicle, TankFluid, build_fluid_train, run_fluid_train,
-    run_fluid_train_observed, run_fluid_train_streamed,
 };
 pub use run::{
-    BrakeScope, LoadFilter, Observer, Progress, SampleSink, TrainFailure, TrainRecord, TrainScenario,
-    WHEEL_OFF_RAIL_LIMIT, build_train, hat_mean_resample, run_train, run_train_observed, run_train_streamed,
+    BrakeScope, Cargo, LoadFilter, Observer, Progress, RigidCargo, RunFailure, RunResult, SampleSink, TrainFailure,
+    TrainRecord, TrainScenario, WHEEL_OFF_RAIL_LIMIT, build_train, hat_mean_resample, run_train, run_vehicle,
     stopped_by_observer,
 };
 pub use tank_car::{

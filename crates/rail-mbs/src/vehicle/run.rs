@@ -80,6 +80,13 @@ impl TrainScenario {
         }
     }
 
+    /// Integrator defaults for a train whose tanks carry ANCF fluid: [`Self::default_hht`]
+    /// with the Jacobian refreshed once the Newton contraction rate exceeds 0.5, as slosh runs
+    /// ([`crate::defaults::slosh_params`]); the fluid's Jacobian is the costly one to refresh.
+    pub fn fluid_hht() -> HhtParams {
+        HhtParams { refresh_rate: crate::defaults::slosh_params().refresh_rate, ..Self::default_hht() }
+    }
+
     /// One car on `track` at `station`, moving at `speed`.
     pub fn single(car: TankCarParams, track: Arc<Track>, station: f64, speed: f64, t_end: f64) -> Self {
         Self {
@@ -289,14 +296,8 @@ impl TrainRecord {
     }
 }
 
-/// A run that stopped early: the error and what was recorded up to it.
-#[derive(Debug)]
-pub struct TrainFailure {
-    /// Why it stopped.
-    pub error: IntegratorError,
-    /// Results up to the failure.
-    pub record: TrainRecord,
-}
+/// A rigid-lading run that stopped early: the error and what was recorded up to it.
+pub type TrainFailure = RunFailure<TrainRecord>;
 
 /// Builds the multibody model of a scenario; returns it with the cars and couplers.
 pub fn build_train(sc: &TrainScenario) -> Result<(Multibody, Vec<CarBodies>, Vec<usize>), AncfError> {
@@ -393,7 +394,7 @@ pub(crate) fn record_sample(
     Ok(())
 }
 
-pub use crate::observe::{Observer, Progress, stopped_by_observer};
+pub use crate::observe::{Observer, Progress, RunFailure, SampleSink, stopped_by_observer};
 
 /// How the load channels of a vehicle record (wheel loads `Q` and `Y`, coupler forces and,
 /// in fluid runs, the fluid force on each tank) are sampled at the recording times.
@@ -696,13 +697,13 @@ pub(crate) fn drive<R: TrainRun>(
     observe: Observer<'_>,
     mut sink: Option<SampleSink<'_>>,
     mut rec: R::Record,
-) -> Result<R::Record, (IntegratorError, R::Record)> {
+) -> Result<R::Record, Box<RunFailure<R::Record>>> {
     let start = Instant::now();
     let mut hht = match Hht::new(sys, 0.0, q0, v0, sc.hht) {
         Ok(h) => h,
         Err(error) => {
             R::train(&mut rec).finish(None, start);
-            return Err((error, rec));
+            return Err(Box::new(RunFailure { error, record: rec }));
         }
     };
     let mut scratch = R::Record::default();
@@ -733,7 +734,7 @@ pub(crate) fn drive<R: TrainRun>(
     R::finish(&hht, &mut rec);
     match result {
         Ok(()) => Ok(rec),
-        Err(error) => Err((error, rec)),
+        Err(error) => Err(Box::new(RunFailure { error, record: rec })),
     }
 }
 
@@ -784,36 +785,61 @@ impl TrainRun for RigidRun<'_> {
     }
 }
 
-/// Runs a scenario; on failure returns what was recorded so far with the error.
-pub fn run_train(sc: &TrainScenario) -> Result<Result<TrainRecord, Box<TrainFailure>>, AncfError> {
-    run_train_observed(sc, &mut |_| true)
+/// What a run returns: the record, or the failure with everything recorded up to it (outer
+/// `Err`: the scenario or cargo could not be built).
+pub type RunResult<R> = Result<Result<R, Box<RunFailure<R>>>, AncfError>;
+
+/// What the tanks carry, by fluid model: the car's own rigid lading ([`RigidCargo`]), the
+/// equivalent slosh model ([`super::EquivalentCargo`]) or the ANCF fluid
+/// ([`super::FluidCargo`]). Every vehicle run is [`run_vehicle`] of a [`TrainScenario`] and a
+/// cargo: one driver ([`drive`]), one failure type ([`RunFailure`]), one observer and
+/// results-stream path, whatever the model.
+pub trait Cargo {
+    /// The run's record: [`TrainRecord`], extended by the model's own channels.
+    type Record;
+    /// The columns of the run's results stream, the layout of the rows its [`SampleSink`]
+    /// receives.
+    fn columns(&self, sc: &TrainScenario) -> Result<Vec<String>, AncfError>;
+    /// Builds the train of `sc` with this cargo and runs it ([`run_vehicle`]).
+    fn run(&self, sc: &TrainScenario, observe: Observer<'_>, sink: Option<SampleSink<'_>>) -> RunResult<Self::Record>;
 }
 
-/// Receives every recorded sample as a flat row (`TrainRecord::row` layout, extended by
-/// `FluidTrainRecord::row` for fluid runs) as soon as it is recorded: a results stream that
-/// an interrupted run cannot lose (e.g. a [`crate::integrator::Journal`]).
-pub type SampleSink<'a> = &'a mut dyn FnMut(&[f64]) -> Result<(), IntegratorError>;
-
-/// [`run_train`] with an [`Observer`] of its progress.
-pub fn run_train_observed(
+/// Runs the train of `sc` carrying `cargo`: `observe` is called after every accepted step
+/// (returning `false` stops the run), `sink` receives every recorded sample as it is recorded
+/// (layout [`Cargo::columns`]). On failure the inner `Err` has the error and what was
+/// recorded up to it.
+pub fn run_vehicle<C: Cargo>(
     sc: &TrainScenario,
-    observe: Observer<'_>,
-) -> Result<Result<TrainRecord, Box<TrainFailure>>, AncfError> {
-    run_train_streamed(sc, observe, None)
-}
-
-/// [`run_train_observed`] that also passes every recorded sample to `sink`.
-pub fn run_train_streamed(
-    sc: &TrainScenario,
+    cargo: &C,
     observe: Observer<'_>,
     sink: Option<SampleSink<'_>>,
-) -> Result<Result<TrainRecord, Box<TrainFailure>>, AncfError> {
-    let (mb, cars, couplers) = build_train(sc)?;
-    let rec = TrainRecord { static_wheel_load: cars[0].static_wheel_load, dof: mb.dof(), ..Default::default() };
-    let init = mb.initial_coordinates();
-    let hints = cars.iter().flat_map(|c| [c.station; 4]).collect();
-    let run = RigidRun { sc, cars, couplers, hints };
-    Ok(drive(run, mb, init, sc, observe, sink, rec).map_err(|(error, record)| Box::new(TrainFailure { error, record })))
+) -> RunResult<C::Record> {
+    cargo.run(sc, observe, sink)
+}
+
+/// The rigid-lading cargo: the tank carries what `TankCarParams::lading` says (a rigid mass at a
+/// height, or nothing) and no sloshing liquid.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct RigidCargo;
+
+impl Cargo for RigidCargo {
+    type Record = TrainRecord;
+    fn columns(&self, sc: &TrainScenario) -> Result<Vec<String>, AncfError> {
+        Ok(TrainRecord::columns(4 * sc.cars, sc.cars.saturating_sub(1), sc.cars))
+    }
+    fn run(&self, sc: &TrainScenario, observe: Observer<'_>, sink: Option<SampleSink<'_>>) -> RunResult<TrainRecord> {
+        let (mb, cars, couplers) = build_train(sc)?;
+        let rec = TrainRecord { static_wheel_load: cars[0].static_wheel_load, dof: mb.dof(), ..Default::default() };
+        let init = mb.initial_coordinates();
+        let hints = cars.iter().flat_map(|c| [c.station; 4]).collect();
+        let run = RigidRun { sc, cars, couplers, hints };
+        Ok(drive(run, mb, init, sc, observe, sink, rec))
+    }
+}
+
+/// [`run_vehicle`] of the rigid-lading cargo, without observer or stream.
+pub fn run_train(sc: &TrainScenario) -> RunResult<TrainRecord> {
+    run_vehicle(sc, &RigidCargo, &mut |_| true, None)
 }
 
 #[cfg(test)]

@@ -113,7 +113,7 @@ pub fn run_braking_with(case: &BrakingCase, step: f64, rel_tol: f64) -> Result<F
     sc.cars = case.cars;
     sc.step = step;
     sc.record_every = 0.02;
-    sc.hht.refresh_rate = 0.5;
+    sc.hht = TrainScenario::fluid_hht();
     sc.hht.rel_tol = rel_tol;
     // Torque sized with the fluid mass of the mesh (total mass of one car).
     let fluid_mass = {
@@ -394,7 +394,7 @@ pub fn curve_run(oil: Oil, speed: f64, counts: [usize; 3], t_end: f64) -> Result
     sc.drive = Some(SpeedProfile::Constant(speed));
     sc.record_every = 0.02;
     sc.step = 4e-3;
-    sc.hht.refresh_rate = 0.5;
+    sc.hht = TrainScenario::fluid_hht();
     let rec = finish(run_fluid_train(&sc, &cg)?)?;
     let m = rec.fluid_mass;
     // CoM acceleration by central differences of the recorded global CoM.

@@ -76,7 +76,10 @@ use ancf_core::mesh::CylinderTankSpec;
 use ancf_core::{Fluid, Rheology};
 use nalgebra::{Matrix3, Vector3};
 
-use super::run::{Observer, SampleSink, TrainRecord, TrainRun, TrainScenario, build_train, drive, record_sample};
+use super::run::{
+    Cargo, Observer, RunFailure, RunResult, SampleSink, TrainRecord, TrainRun, TrainScenario, build_train, drive,
+    record_sample,
+};
 use super::tank_car::CarBodies;
 use crate::integrator::{Hht, IntegratorError};
 use crate::mbs::{BodyId, Bushing, Multibody, RigidBody};
@@ -146,9 +149,7 @@ impl EquivalentCargo {
         if !(self.viscosity.is_finite() && (0.0..=1e5).contains(&self.viscosity)) {
             return Err(invalid("viscosity", self.viscosity, "0 to 1e5 Pa s"));
         }
-        if !(self.fill.is_finite() && self.fill > 0.0 && self.fill <= 0.97) {
-            return Err(invalid("fill", self.fill, "a volume fraction in (0, 0.97]"));
-        }
+        ancf_core::mesh::check_fill(self.fill)?;
         if !(self.head_depth.is_finite() && self.head_depth >= 0.0) {
             return Err(invalid("head_depth", self.head_depth, "finite, >= 0 m"));
         }
@@ -558,13 +559,7 @@ impl EquivalentTrainRecord {
 }
 
 /// An equivalent-model run that stopped early: why, and what was recorded.
-#[derive(Debug)]
-pub struct EquivalentTrainFailure {
-    /// The error.
-    pub error: IntegratorError,
-    /// Results up to the failure.
-    pub record: EquivalentTrainRecord,
-}
+pub type EquivalentTrainFailure = RunFailure<EquivalentTrainRecord>;
 
 fn record_equivalent(
     mb: &Multibody,
@@ -584,22 +579,33 @@ fn record_equivalent(
     rec.slosh_displacement.push(disp);
 }
 
-/// Runs a train with equivalent slosh models; on failure returns what was recorded.
-pub fn run_equivalent_train(
-    sc: &TrainScenario,
-    cargo: &EquivalentCargo,
-) -> Result<Result<EquivalentTrainRecord, Box<EquivalentTrainFailure>>, AncfError> {
-    run_equivalent_train_streamed(sc, cargo, &mut |_| true, None)
+/// [`run_vehicle`](super::run_vehicle) of an equivalent-model cargo, without observer or stream.
+pub fn run_equivalent_train(sc: &TrainScenario, cargo: &EquivalentCargo) -> RunResult<EquivalentTrainRecord> {
+    super::run_vehicle(sc, cargo, &mut |_| true, None)
 }
 
-/// [`run_equivalent_train`] with an [`Observer`] and a results stream (layout
-/// [`EquivalentTrainRecord::columns`]).
-pub fn run_equivalent_train_streamed(
+impl Cargo for EquivalentCargo {
+    type Record = EquivalentTrainRecord;
+    fn columns(&self, sc: &TrainScenario) -> Result<Vec<String>, AncfError> {
+        let modes = self.model(&sc.car, crate::track::GRAVITY)?.modes.len();
+        Ok(EquivalentTrainRecord::columns(4 * sc.cars, sc.cars.saturating_sub(1), sc.cars, modes))
+    }
+    fn run(
+        &self,
+        sc: &TrainScenario,
+        observe: Observer<'_>,
+        sink: Option<SampleSink<'_>>,
+    ) -> RunResult<EquivalentTrainRecord> {
+        run_equivalent(sc, self, observe, sink)
+    }
+}
+
+fn run_equivalent(
     sc: &TrainScenario,
     cargo: &EquivalentCargo,
     observe: Observer<'_>,
     sink: Option<SampleSink<'_>>,
-) -> Result<Result<EquivalentTrainRecord, Box<EquivalentTrainFailure>>, AncfError> {
+) -> RunResult<EquivalentTrainRecord> {
     let built = build_equivalent_train(sc, cargo)?;
     let EquivalentTrain { mb, cars, couplers, slosh, model, tank_origin_height } = built;
     let rec = EquivalentTrainRecord {
@@ -610,8 +616,7 @@ pub fn run_equivalent_train_streamed(
     let init = mb.initial_coordinates();
     let hints = cars.iter().flat_map(|c| [c.station; 4]).collect();
     let run = EquivalentRun { sc, cars, couplers, slosh, model, tank_origin_height, hints };
-    Ok(drive(run, mb, init, sc, observe, sink, rec)
-        .map_err(|(error, record)| Box::new(EquivalentTrainFailure { error, record })))
+    Ok(drive(run, mb, init, sc, observe, sink, rec))
 }
 
 /// The equivalent-model run ([`run_equivalent_train`]): the vehicle channels and the slosh

@@ -12,7 +12,8 @@ use ancf_core::tank::{Bulkhead, TankGeometry};
 use super::*;
 use crate::integrator::{Hht, IntegratorError};
 use crate::vehicle::run::{
-    Observer, SampleSink, TrainRecord, TrainRun, TrainScenario, build_train, drive, record_sample,
+    Cargo, Observer, RunFailure, RunResult, SampleSink, TrainRecord, TrainRun, TrainScenario, build_train, drive,
+    record_sample, run_vehicle,
 };
 use crate::vehicle::tank_car::CarBodies;
 
@@ -170,13 +171,7 @@ impl FluidTrainRecord {
 }
 
 /// A fluid run that stopped early: why, and what was recorded.
-#[derive(Debug)]
-pub struct FluidTrainFailure {
-    /// The error.
-    pub error: IntegratorError,
-    /// Results up to the failure.
-    pub record: FluidTrainRecord,
-}
+pub type FluidTrainFailure = RunFailure<FluidTrainRecord>;
 
 /// Builds a train whose tanks carry `cargo` as ANCF fluid bodies.
 pub fn build_fluid_train(
@@ -264,31 +259,32 @@ fn record_fluid(sys: &FluidVehicle, q: &[f64], v: &[f64], rec: &mut FluidTrainRe
     rec.energy_error.push(eps);
 }
 
-/// Runs a train with fluid cargo; on failure returns what was recorded with the error.
-pub fn run_fluid_train(
-    sc: &TrainScenario,
-    cargo: &FluidCargo,
-) -> Result<Result<FluidTrainRecord, Box<FluidTrainFailure>>, AncfError> {
-    run_fluid_train_observed(sc, cargo, &mut |_| true)
+/// [`run_vehicle`](crate::vehicle::run_vehicle) of an ANCF fluid cargo, without observer or stream.
+pub fn run_fluid_train(sc: &TrainScenario, cargo: &FluidCargo) -> RunResult<FluidTrainRecord> {
+    run_vehicle(sc, cargo, &mut |_| true, None)
 }
 
-/// [`run_fluid_train`] with an [`Observer`] of its progress.
-pub fn run_fluid_train_observed(
-    sc: &TrainScenario,
-    cargo: &FluidCargo,
-    observe: Observer<'_>,
-) -> Result<Result<FluidTrainRecord, Box<FluidTrainFailure>>, AncfError> {
-    run_fluid_train_streamed(sc, cargo, observe, None)
+impl Cargo for FluidCargo {
+    type Record = FluidTrainRecord;
+    fn columns(&self, sc: &TrainScenario) -> Result<Vec<String>, AncfError> {
+        Ok(FluidTrainRecord::columns(4 * sc.cars, sc.cars.saturating_sub(1), sc.cars))
+    }
+    fn run(
+        &self,
+        sc: &TrainScenario,
+        observe: Observer<'_>,
+        sink: Option<SampleSink<'_>>,
+    ) -> RunResult<FluidTrainRecord> {
+        run_fluid(sc, self, observe, sink)
+    }
 }
 
-/// [`run_fluid_train_observed`] that also passes every recorded sample to `sink`
-/// (layout [`FluidTrainRecord::columns`]).
-pub fn run_fluid_train_streamed(
+fn run_fluid(
     sc: &TrainScenario,
     cargo: &FluidCargo,
     observe: Observer<'_>,
     sink: Option<SampleSink<'_>>,
-) -> Result<Result<FluidTrainRecord, Box<FluidTrainFailure>>, AncfError> {
+) -> RunResult<FluidTrainRecord> {
     let (sys, cars, couplers) = build_fluid_train(sc, cargo)?;
     let mut rec = FluidTrainRecord {
         fluid_mass: sys.fluids[0].body.total_mass(),
@@ -301,8 +297,7 @@ pub fn run_fluid_train_streamed(
     let init = sys.initial_coordinates();
     let hints = cars.iter().flat_map(|c| [c.station; 4]).collect();
     let run = FluidRun { sc, nr: sys.mb.n_coords(), cars, couplers, hints };
-    Ok(drive(run, sys, init, sc, observe, sink, rec)
-        .map_err(|(error, record)| Box::new(FluidTrainFailure { error, record })))
+    Ok(drive(run, sys, init, sc, observe, sink, rec))
 }
 
 /// The ANCF-fluid run ([`run_fluid_train`]): the vehicle channels, each fluid's, and snapshots.
