@@ -225,3 +225,20 @@ def test_the_run_kernels_take_one_train_dict_and_name_a_bad_key_in_it():
     res = _core.run_train(train)
     assert res["stats"]["steps"] == 10
     assert np.asarray(res["wheel_vertical"]).shape[1] == 4
+
+
+def test_the_slosh_kernel_takes_one_scenario_dict_and_names_a_bad_key_in_it():
+    m = rs.mesh.box((1.0, 0.4, 0.3), (1, 1, 1))
+    fluid = rs.fluids.newtonian(1000.0, 1e-3, depth=0.3)
+    scenario = {"tank_shape": "box", "tank_dims": [-0.5, -0.2, 0.0, 0.5, 0.2, 0.6], "t_end": 0.01, "h": 0.005}
+    with pytest.raises(ValueError, match=r"invalid `scenario` = stepsize: expected keys among \[.*\"h\""):
+        _core.run_slosh(m, fluid, {**scenario, "stepsize": 1e-3})
+    with pytest.raises(ValueError, match=r"invalid `scenario.h` = missing"):
+        _core.run_slosh(m, fluid, {k: v for k, v in scenario.items() if k != "h"})
+    with pytest.raises(TypeError, match=r"invalid `viscous_points` = 'three': "):
+        _core.run_slosh(m, fluid, {**scenario, "viscous_points": "three"})
+    # left-out keys take SloshScenario::new's defaults (at rest under gravity); every step recorded
+    res = _core.run_slosh(m, fluid, scenario)
+    assert res["error"] is None
+    assert res["t"][-1] == pytest.approx(0.01)
+    assert np.all(np.diff(res["t"]) <= 0.005 + 1e-12)

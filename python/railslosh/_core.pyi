@@ -154,35 +154,45 @@ def elliptic_cylinder(
     n_height: int,
 ) -> FluidMesh: ...
 def validation_cases() -> list[str]: ...
+
+class _SloshRequired(TypedDict):
+    tank_shape: str
+    tank_dims: list[float]
+    t_end: float
+    h: float
+
+class SloshArgs(_SloshRequired, total=False):
+    """The scenario of ``run_slosh`` (``railslosh.slosh.run`` builds it); a key left out or ``None``
+    takes ``rail_mbs::slosh::SloshScenario::new``'s default; an unknown key is a ValueError."""
+
+    bulkheads: list[tuple[float, float]]
+    acceleration: list[list[tuple[float, float]]]
+    rotation_axis: tuple[float, float, float] | None
+    angular_acceleration: list[tuple[float, float]]
+    frame: str
+    gravity: list[float]
+    viscous_points: int
+    penalty_points: int
+    volume_tolerance: float
+    penetration_limit: float
+    contact_stiffness_factor: float
+    contact_points_per_edge: int
+    contact_point_rule: str
+    stepper: str
+    wall_damping_ratio: float
+    snapshot_every: float
+    wall_adhesion: float
+
 def run_slosh(
     mesh: FluidMesh,
     fluid: Fluid,
-    tank_shape: str,
-    tank_dims: list[float],
-    bulkheads: list[tuple[float, float]],
-    acceleration: list[list[tuple[float, float]]],
-    rotation_axis: tuple[float, float, float] | None,
-    angular_acceleration: list[tuple[float, float]],
-    t_end: float,
-    h: float,
-    frame: str = "inertial",
-    gravity: list[float] = ...,
-    viscous_points: int = 3,
-    penalty_points: int = 3,
+    scenario: SloshArgs,
+    *,
     progress: _Progress | None = None,
-    volume_tolerance: float = 0.01,
-    penetration_limit: float = 0.5,
-    contact_stiffness_factor: float = 1.0,
     stream: str | os.PathLike[str] | None = None,
     checkpoint: str | os.PathLike[str] | None = None,
     checkpoint_every: int = 100,
     resume_from: str | os.PathLike[str] | None = None,
-    contact_points_per_edge: int = 3,
-    contact_point_rule: str = "gauss",
-    stepper: str = "implicit",
-    wall_damping_ratio: float = ...,
-    snapshot_every: float = 0.0,
-    wall_adhesion: float = 0.0,
 ) -> dict[str, Any]: ...
 def run_validation(name: str, quick: bool = False) -> list[dict[str, Any]]: ...
 def work_precision_cases() -> list[str]: ...

@@ -231,27 +231,20 @@ def run(
         raise ValueError(f"invalid `motion.acceleration` axes {sorted(unknown)}: expected x, y, z")
     acc = [motion.acceleration.get(a, []) for a in ("x", "y", "z")]
     with progress_callback(progress, "slosh run") as on_progress:
-        res = _core.run_slosh(
-            mesh,
-            fluid,
-            tank.shape,
-            list(tank.dims),
-            list(tank.bulkheads),
-            acc,
-            motion.rotation_axis,
-            motion.angular_acceleration,
-            t_end,
-            h,
-            frame,
-            list(gravity),
-            progress=on_progress,
+        scenario = dict(
+            tank_shape=tank.shape,
+            tank_dims=list(tank.dims),
+            bulkheads=list(tank.bulkheads),
+            acceleration=acc,
+            rotation_axis=motion.rotation_axis,
+            angular_acceleration=motion.angular_acceleration,
+            t_end=t_end,
+            h=h,
+            frame=frame,
+            gravity=list(gravity),
             volume_tolerance=volume_tolerance,
             penetration_limit=penetration_limit,
             contact_stiffness_factor=contact_stiffness_factor,
-            stream=None if stream is None else os.fspath(stream),
-            checkpoint=None if checkpoint is None else os.fspath(checkpoint),
-            checkpoint_every=checkpoint_every,
-            resume_from=None if resume_from is None else os.fspath(resume_from),
             viscous_points=viscous_points,
             penalty_points=penalty_points,
             contact_points_per_edge=contact_points_per_edge,
@@ -259,6 +252,16 @@ def run(
             wall_damping_ratio=wall_damping_ratio,
             snapshot_every=snapshot_every,
             wall_adhesion=wall_adhesion,
+        )
+        res = _core.run_slosh(
+            mesh,
+            fluid,
+            scenario,
+            progress=on_progress,
+            stream=None if stream is None else os.fspath(stream),
+            checkpoint=None if checkpoint is None else os.fspath(checkpoint),
+            checkpoint_every=checkpoint_every,
+            resume_from=None if resume_from is None else os.fspath(resume_from),
         )
     res["wall_damping_ratio"] = wall_damping_ratio
     res["wall_adhesion"] = wall_adhesion

@@ -10,6 +10,7 @@
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
+mod args;
 mod bench;
 mod cosim;
 mod irregularity;
@@ -493,55 +494,37 @@ impl PyFluidBody {
 
 /// Run fluid sloshing in a rigid tank with prescribed motion (see `railslosh.slosh.run`).
 ///
+/// `scenario` is one dict (the stubs' `SloshArgs`): the tank `tank_shape` with its `tank_dims`
+/// and `bulkheads`, the motion (`acceleration` per axis x, y, z, `rotation_axis`,
+/// `angular_acceleration`), `t_end` and the recorded step `h`, and the model settings; keys left
+/// out take `rail_mbs::slosh::SloshScenario::new`'s defaults, and an unknown key is an error.
 /// Returns a dict of numpy arrays (`t`, `force_tank`, `moment_tank`, `force_global`,
 /// `moment_global`, `com_tank`, `volume`, `kinetic_energy`, `potential_energy`,
 /// `newton_iterations`, `max_penetration`) plus `error` (None, or the message of the failure
 /// that stopped the run; the arrays then hold everything computed before it) and `stats`.
 #[pyfunction]
-#[pyo3(signature = (mesh, fluid, tank_shape, tank_dims, bulkheads, acceleration, rotation_axis, angular_acceleration,
-                    t_end, h, frame="inertial", gravity=[0.0, 0.0, -ancf_core::constants::GRAVITY], viscous_points=3, penalty_points=3,
-                    progress=None, volume_tolerance=0.01, penetration_limit=0.5, contact_stiffness_factor=1.0,
-                    stream=None, checkpoint=None, checkpoint_every=100, resume_from=None,
-                    contact_points_per_edge=3, contact_point_rule="gauss", stepper="implicit",
-                    wall_damping_ratio=ancf_core::contact::WALL_DAMPING_RATIO, snapshot_every=0.0, wall_adhesion=0.0))]
+#[pyo3(signature = (mesh, fluid, scenario, *, progress=None, stream=None, checkpoint=None, checkpoint_every=100, resume_from=None))]
 #[allow(clippy::too_many_arguments)]
 fn run_slosh<'py>(
     py: Python<'py>,
     mesh: &PyFluidMesh,
     fluid: &PyFluid,
-    tank_shape: &str,
-    tank_dims: Vec<f64>,
-    bulkheads: Vec<(f64, f64)>,
-    acceleration: [Vec<(f64, f64)>; 3],
-    rotation_axis: Option<[f64; 3]>,
-    angular_acceleration: Vec<(f64, f64)>,
-    t_end: f64,
-    h: f64,
-    frame: &str,
-    gravity: [f64; 3],
-    viscous_points: usize,
-    penalty_points: usize,
+    scenario: &Bound<'py, PyDict>,
     progress: Option<Py<PyAny>>,
-    volume_tolerance: f64,
-    penetration_limit: f64,
-    contact_stiffness_factor: f64,
     stream: Option<std::path::PathBuf>,
     checkpoint: Option<std::path::PathBuf>,
     checkpoint_every: usize,
     resume_from: Option<std::path::PathBuf>,
-    contact_points_per_edge: usize,
-    contact_point_rule: &str,
-    stepper: &str,
-    wall_damping_ratio: f64,
-    snapshot_every: f64,
-    wall_adhesion: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
     use ancf_core::contact::ContactPointRule;
     use ancf_core::tank::{Bulkhead, TankShape};
     use rail_mbs::slosh::{PiecewiseAcceleration, SloshFrame, SloshScenario, StepperChoice};
-    let choice = StepperChoice::parse(stepper).map_err(crate::to_py)?;
+    let mut a = args::Args::new("scenario", scenario);
+    let stepper: Option<String> = a.opt("stepper")?;
+    let choice = StepperChoice::parse(stepper.as_deref().unwrap_or("implicit")).map_err(crate::to_py)?;
     let bad = |f: &str, v: String, a: &str| PyValueError::new_err(format!("invalid `{f}` = {v}: expected {a}"));
-    let shape = match (tank_shape, tank_dims.as_slice()) {
+    let (tank_shape, tank_dims): (String, Vec<f64>) = (a.req("tank_shape")?, a.req("tank_dims")?);
+    let shape = match (tank_shape.as_str(), tank_dims.as_slice()) {
         ("cylinder", &[length, radius, head_depth]) => TankShape::Cylinder { length, radius, head_depth },
         ("elliptic", &[length, semi_axis_y, semi_axis_z]) => {
             TankShape::EllipticCylinder { length, semi_axis_y, semi_axis_z }
@@ -555,39 +538,49 @@ fn run_slosh<'py>(
             ));
         }
     };
-    let point_rule = match contact_point_rule {
-        "gauss" => ContactPointRule::Gauss,
-        "lobatto" => ContactPointRule::Lobatto,
-        other => return Err(bad("contact_point_rule", format!("{other:?}"), "\"gauss\" or \"lobatto\"")),
-    };
-    let frame = match frame {
-        "inertial" => SloshFrame::Inertial,
-        "tank" => SloshFrame::Tank,
-        other => return Err(bad("frame", format!("{other:?}"), "\"inertial\" or \"tank\"")),
-    };
+    let (t_end, h): (f64, f64) = (a.req("t_end")?, a.req("h")?);
     if !(t_end.is_finite() && t_end > 0.0) {
         return Err(bad("t_end", t_end.to_string(), "a finite number > 0"));
     }
     if !(h.is_finite() && h > 0.0 && h <= t_end) {
         return Err(bad("h", h.to_string(), "a finite number in (0, t_end]"));
     }
+    let snapshot_every: f64 = a.opt("snapshot_every")?.unwrap_or(0.0);
     if !(snapshot_every.is_finite() && snapshot_every >= 0.0) {
         return Err(bad("snapshot_every", snapshot_every.to_string(), "a finite interval >= 0 s (0: no snapshots)"));
     }
-    // The model, with the library's defaults for what the keywords leave (rail_mbs::slosh::scenario).
+    // The model, with the library's defaults for what the dict leaves (rail_mbs::slosh::scenario).
     let mut scenario = SloshScenario::new(mesh.inner.clone(), fluid.inner, shape);
+    let bulkheads: Vec<(f64, f64)> = a.opt("bulkheads")?.unwrap_or_default();
     scenario.bulkheads = bulkheads.iter().map(|&(x, thickness)| Bulkhead { x, thickness }).collect();
-    scenario.gravity = gravity;
-    scenario.frame = frame;
-    scenario.quadrature = QuadratureOptions { viscous: viscous_points, penalty: penalty_points, mass: 4 };
-    scenario.contact_points_per_edge = contact_points_per_edge;
-    scenario.contact_point_rule = point_rule;
-    scenario.contact_stiffness_factor = contact_stiffness_factor;
-    scenario.wall_damping_ratio = wall_damping_ratio;
-    scenario.wall_adhesion = wall_adhesion;
+    scenario.gravity = a.opt("gravity")?.unwrap_or(scenario.gravity);
+    if let Some(frame) = a.opt::<String>("frame")? {
+        scenario.frame = match frame.as_str() {
+            "inertial" => SloshFrame::Inertial,
+            "tank" => SloshFrame::Tank,
+            other => return Err(bad("frame", format!("{other:?}"), "\"inertial\" or \"tank\"")),
+        };
+    }
+    scenario.quadrature.viscous = a.opt("viscous_points")?.unwrap_or(scenario.quadrature.viscous);
+    scenario.quadrature.penalty = a.opt("penalty_points")?.unwrap_or(scenario.quadrature.penalty);
+    scenario.contact_points_per_edge = a.opt("contact_points_per_edge")?.unwrap_or(scenario.contact_points_per_edge);
+    if let Some(rule) = a.opt::<String>("contact_point_rule")? {
+        scenario.contact_point_rule = match rule.as_str() {
+            "gauss" => ContactPointRule::Gauss,
+            "lobatto" => ContactPointRule::Lobatto,
+            other => return Err(bad("contact_point_rule", format!("{other:?}"), "\"gauss\" or \"lobatto\"")),
+        };
+    }
+    scenario.contact_stiffness_factor = a.opt("contact_stiffness_factor")?.unwrap_or(scenario.contact_stiffness_factor);
+    scenario.wall_damping_ratio = a.opt("wall_damping_ratio")?.unwrap_or(scenario.wall_damping_ratio);
+    scenario.wall_adhesion = a.opt("wall_adhesion")?.unwrap_or(scenario.wall_adhesion);
     // Failure guards (issue 8): relative volume error and wall penetration per smallest element edge.
-    scenario.volume_tolerance = volume_tolerance;
-    scenario.penetration_limit = penetration_limit;
+    scenario.volume_tolerance = a.opt("volume_tolerance")?.unwrap_or(scenario.volume_tolerance);
+    scenario.penetration_limit = a.opt("penetration_limit")?.unwrap_or(scenario.penetration_limit);
+    let acceleration: [Vec<(f64, f64)>; 3] = a.opt("acceleration")?.unwrap_or_default();
+    let rotation_axis: Option<[f64; 3]> = a.opt("rotation_axis")?;
+    let angular_acceleration: Vec<(f64, f64)> = a.opt("angular_acceleration")?.unwrap_or_default();
+    a.finish()?;
     scenario.validate().map_err(to_py)?;
     let connectivity: Vec<i64> = scenario.mesh.elements.iter().flatten().map(|&n| n as i64).collect();
     let mut observer = PyProgress::new(progress);

@@ -1,7 +1,7 @@
 //! One typed description of a slosh run (issue 18): the liquid, its tank, the motion and the
 //! discretization, with the library's defaults, built into a [`SloshSystem`] and started as a
 //! [`SloshRun`] here, in Rust, where it is tested. The Python binding (`run_slosh`) only fills
-//! it from its keyword arguments.
+//! it from its `scenario` dict.
 
 use ancf_core::FluidBody;
 use ancf_core::constitutive::Fluid;

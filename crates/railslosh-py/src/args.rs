@@ -1,0 +1,63 @@
+//! A run's settings passed as one dict instead of long keyword lists (issue 18): the vehicle
+//! runs' `train` and `cargo`, the slosh run's `scenario`. The stubs type each dict
+//! (`railslosh._core.TrainArgs`, ...); here they are read key by key into the Rust scenario.
+
+use ancf_core::error::invalid;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// The keyword arguments of a run held in one dict (`train`, `cargo`), read key by key: a value
+/// of the wrong type is a `TypeError` naming its key and value, a missing required key or an
+/// unknown one a `ValueError` naming it, and `None` or a left-out key means the default.
+pub(crate) struct Args<'a, 'py> {
+    d: &'a Bound<'py, PyDict>,
+    what: &'static str,
+    read: Vec<&'static str>,
+}
+
+impl<'a, 'py> Args<'a, 'py> {
+    pub(crate) fn new(what: &'static str, d: &'a Bound<'py, PyDict>) -> Self {
+        Self { d, what, read: Vec::new() }
+    }
+
+    /// The value of `key`, `None` when it is left out or `None`.
+    pub(crate) fn opt<T: for<'b> FromPyObject<'b, 'py>>(&mut self, key: &'static str) -> PyResult<Option<T>>
+    where
+        for<'b> <T as FromPyObject<'b, 'py>>::Error: Into<PyErr>,
+    {
+        self.read.push(key);
+        let Some(v) = self.d.get_item(key)? else { return Ok(None) };
+        if v.is_none() {
+            return Ok(None);
+        }
+        match v.extract::<T>() {
+            Ok(x) => Ok(Some(x)),
+            Err(e) => {
+                let e: PyErr = e.into();
+                let shown = v.repr().map_or_else(|_| "?".to_string(), |r| r.to_string());
+                Err(pyo3::exceptions::PyTypeError::new_err(format!("invalid `{key}` = {shown}: {}", e.value(v.py()))))
+            }
+        }
+    }
+
+    /// The value of `key`, which must be given.
+    pub(crate) fn req<T: for<'b> FromPyObject<'b, 'py>>(&mut self, key: &'static str) -> PyResult<T>
+    where
+        for<'b> <T as FromPyObject<'b, 'py>>::Error: Into<PyErr>,
+    {
+        let what = self.what;
+        self.opt(key)?.ok_or_else(|| crate::to_py(invalid(&format!("{what}.{key}"), "missing", "a value")))
+    }
+
+    /// Checks that every key of the dict was read: a misspelt one is an error, not a setting
+    /// silently left at its default.
+    pub(crate) fn finish(self) -> PyResult<()> {
+        for k in self.d.keys() {
+            let k: String = k.extract()?;
+            if !self.read.contains(&k.as_str()) {
+                return Err(crate::to_py(invalid(self.what, &k, &format!("keys among {:?}", self.read))));
+            }
+        }
+        Ok(())
+    }
+}
