@@ -35,6 +35,7 @@
 
 pub mod equivalent;
 pub mod fluid;
+mod record;
 mod run;
 mod tank_car;
 
