@@ -45,7 +45,7 @@ def main() -> None:
         tank,
         motion,
         t_end=1.5 if a.quick else 3.0,
-        h=0.004,
+        step=0.004,
         viscous_points=4,
         penalty_points=4,
         contact_points_per_edge=5,

@@ -230,11 +230,11 @@ def test_the_run_kernels_take_one_train_dict_and_name_a_bad_key_in_it():
 def test_the_slosh_kernel_takes_one_scenario_dict_and_names_a_bad_key_in_it():
     m = rs.mesh.box((1.0, 0.4, 0.3), (1, 1, 1))
     fluid = rs.fluids.newtonian(1000.0, 1e-3, depth=0.3)
-    scenario = {"tank_shape": "box", "tank_dims": [-0.5, -0.2, 0.0, 0.5, 0.2, 0.6], "t_end": 0.01, "h": 0.005}
-    with pytest.raises(ValueError, match=r"invalid `scenario` = stepsize: expected keys among \[.*\"h\""):
+    scenario = {"tank_shape": "box", "tank_dims": [-0.5, -0.2, 0.0, 0.5, 0.2, 0.6], "t_end": 0.01, "step": 0.005}
+    with pytest.raises(ValueError, match=r"invalid `scenario` = stepsize: expected keys among \[.*\"step\""):
         _core.run_slosh(m, fluid, {**scenario, "stepsize": 1e-3})
-    with pytest.raises(ValueError, match=r"invalid `scenario.h` = missing"):
-        _core.run_slosh(m, fluid, {k: v for k, v in scenario.items() if k != "h"})
+    with pytest.raises(ValueError, match=r"invalid `scenario.step` = missing"):
+        _core.run_slosh(m, fluid, {k: v for k, v in scenario.items() if k != "step"})
     with pytest.raises(TypeError, match=r"invalid `viscous_points` = 'three': "):
         _core.run_slosh(m, fluid, {**scenario, "viscous_points": "three"})
     # left-out keys take SloshScenario::new's defaults (at rest under gravity); every step recorded

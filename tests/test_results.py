@@ -68,7 +68,7 @@ def test_netcdf_round_trip_keeps_values_and_attributes(fluid_run, tmp_path):
 def test_slosh_results_become_a_dataset():
     mesh = rs.mesh.box((0.4, 0.3, 0.1), (1, 2, 1))
     tank = rs.slosh.TankGeometry.box((-0.2, -0.15, 0.0), (0.2, 0.15, 0.3))
-    res = rs.slosh.run(mesh, rs.fluids.water(depth=0.1), tank, rs.slosh.Motion(), t_end=0.05, h=0.01)
+    res = rs.slosh.run(mesh, rs.fluids.water(depth=0.1), tank, rs.slosh.Motion(), t_end=0.05, step=0.01)
     ds = results.to_dataset(res)
     assert ds["force_tank"].dims == ("time", "component") and ds["force_tank"].attrs["units"] == "N"
     assert ds["moment_global"].attrs["frame"] == "global" and ds["volume"].attrs["units"] == "m3"

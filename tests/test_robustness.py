@@ -71,7 +71,7 @@ def test_soft_penalty_stops_with_a_typed_volume_error_and_keeps_results():
     k = 0.01 * fluids.default_bulk_penalty(998.0, BOX[2])
     fluid = fluids.newtonian(998.0, 1e-3, depth=BOX[2], bulk_penalty=k)
     with pytest.raises(slosh.SimulationError) as info:
-        slosh.run(mesh.box(BOX, (2, 3, 2)), fluid, TANK, t_end=0.5, h=0.01)
+        slosh.run(mesh.box(BOX, (2, 3, 2)), fluid, TANK, t_end=0.5, step=0.01)
     err = info.value
     assert err.cause == "volume_error", str(err)
     assert "deviates from its reference" in str(err) and "limit 1.000%" in str(err)
@@ -92,7 +92,7 @@ def test_deep_wall_penetration_stops_with_a_typed_error():
             fluid,
             TANK,
             t_end=0.5,
-            h=0.01,
+            step=0.01,
             contact_stiffness_factor=0.01,
             penetration_limit=0.1,
         )
@@ -108,7 +108,7 @@ def test_deep_wall_penetration_stops_with_a_typed_error():
         fluid,
         TANK,
         t_end=0.3,
-        h=0.01,
+        step=0.01,
         contact_stiffness_factor=0.01,
         viscous_points=4,
         penalty_points=4,
@@ -150,7 +150,7 @@ h = hashlib.sha256()
 if {kind!r} == "slosh":
     tank = slosh.TankGeometry.box((-0.208, -0.162, 0.0), (0.208, 0.162, 0.3))
     motion = slosh.Motion().pulse("y", 3.0, 0.0, 0.1)
-    res = slosh.run(mesh.box({BOX!r}, (2, 3, 2)), fluids.water(depth=0.132), tank, motion, t_end=0.1, h=0.01)
+    res = slosh.run(mesh.box({BOX!r}, (2, 3, 2)), fluids.water(depth=0.132), tank, motion, t_end=0.1, step=0.01)
     keys = ["t", "force_tank", "volume", "com_tank", "newton_iterations"]
 else:
     track = rail.Track([0.0, 5000.0], curvature=[0.0, 0.0], superelevation=[0.0, 0.0])

@@ -14,7 +14,7 @@ def small_tank():
 
 def test_fluid_at_rest_presses_its_weight_on_the_tank_and_keeps_its_volume():
     mesh, tank, water = small_tank()
-    res = rs.slosh.run(mesh, water, tank, t_end=0.6, h=0.005)
+    res = rs.slosh.run(mesh, water, tank, t_end=0.6, step=0.005)
     t = res["t"]
     assert t[0] == 0.0 and t[-1] == pytest.approx(0.6)
     m = 998.0 * 0.4 * 0.3 * 0.12
@@ -30,7 +30,7 @@ def test_fluid_at_rest_presses_its_weight_on_the_tank_and_keeps_its_volume():
 def test_lateral_pulse_pushes_the_fluid_back_in_the_tank_frame():
     mesh, tank, water = small_tank()
     motion = rs.slosh.Motion().pulse("y", 2.0, 0.05, 0.35, ramp=0.05)
-    res = rs.slosh.run(mesh, water, tank, motion, t_end=0.35, h=0.005, frame="tank")
+    res = rs.slosh.run(mesh, water, tank, motion, t_end=0.35, step=0.005, frame="tank")
     # accelerating in +y, the liquid lags: its centre of mass moves to -y in the tank
     assert res["com_tank"][-1, 1] < -1e-4
     # and the walls push it forward: the fluid's load on the tank points to -y
@@ -45,8 +45,8 @@ def test_bad_inputs_name_the_field():
         rs.slosh.run(mesh, water, rs.slosh.TankGeometry("sphere", (1.0,)), t_end=0.1)
     with pytest.raises(ValueError, match="axis"):
         rs.slosh.Motion().pulse("w", 1.0, 0.0, 1.0)
-    with pytest.raises(ValueError, match="h"):
-        rs.slosh.run(mesh, water, tank, t_end=0.1, h=-1.0)
+    with pytest.raises(ValueError, match=r"invalid `step` = -1: expected a finite number in \(0, t_end\]"):
+        rs.slosh.run(mesh, water, tank, t_end=0.1, step=-1.0)
 
 
 def test_a_failing_run_says_where_and_keeps_what_it_computed():
@@ -58,7 +58,7 @@ def test_a_failing_run_says_where_and_keeps_what_it_computed():
     # (the element check of issue 16 stops it when the volume ratio falls to 0.1 at any
     # quadrature or check point, before it inverts)
     with pytest.raises(rs.slosh.SimulationError, match=r"t = .*element \d+ (inverted|distorted)") as info:
-        rs.slosh.run(mesh, fluid, tank, motion, t_end=1.0, h=0.01, volume_tolerance=0.9)
+        rs.slosh.run(mesh, fluid, tank, motion, t_end=1.0, step=0.01, volume_tolerance=0.9)
     assert info.value.cause in ("inverted_element", "distorted_element")
     res = info.value.results
     assert len(res["t"]) > 10 and res["error"]
@@ -71,7 +71,7 @@ def test_the_explicit_stepper_runs_the_same_physics_and_says_which_stepper_ran()
     implicit run's hydrostatics and sloshing; ``"auto"`` picks one and says why."""
     mesh, tank, water = small_tank()
     motion = rs.slosh.Motion().pulse("y", 2.0, 0.05, 0.35, ramp=0.05)
-    kw = dict(t_end=0.6, h=0.01, viscous_points=4, penalty_points=4)
+    kw = dict(t_end=0.6, step=0.01, viscous_points=4, penalty_points=4)
     imp = rs.slosh.run(mesh, water, tank, motion, **kw)
     exp = rs.slosh.run(mesh, water, tank, motion, **kw, stepper="explicit")
     assert imp["stepper"] == "implicit" and exp["stepper"] == "explicit"
@@ -101,7 +101,7 @@ def test_critical_wall_damping_takes_the_wall_ringing_out_of_the_load():
     water = rs.fluids.water(depth=L[2])
     tank = rs.slosh.TankGeometry.box((-L[0] / 2, -L[1] / 2, 0.0), (L[0] / 2, L[1] / 2, 0.3))
     motion = rs.slosh.Motion().pulse("y", 0.3 * 9.81, 0.1, 0.6, ramp=0.02)
-    kw = dict(t_end=3.0, h=0.004, penalty_points=4, contact_points_per_edge=4)
+    kw = dict(t_end=3.0, step=0.004, penalty_points=4, contact_points_per_edge=4)
     share, f1 = {}, {}
     for zeta in (rs.vehicle.WALL_DAMPING_RATIO, 1.0):
         r = rs.slosh.run(m, water, tank, motion, **kw, wall_damping_ratio=zeta)
@@ -132,7 +132,7 @@ def test_an_adhesive_wall_keeps_the_wetted_liquid_from_peeling_off_and_slapping_
     water = rs.fluids.water(depth=L[2])
     tank = rs.slosh.TankGeometry.box((-L[0] / 2, -L[1] / 2, 0.0), (L[0] / 2, L[1] / 2, 0.3))
     motion = rs.slosh.Motion().pulse("y", 0.3 * 9.81, 0.1, 0.6, ramp=0.02)
-    kw = dict(t_end=2.0, h=0.004, penalty_points=4, contact_points_per_edge=4, wall_damping_ratio=1.0)
+    kw = dict(t_end=2.0, step=0.004, penalty_points=4, contact_points_per_edge=4, wall_damping_ratio=1.0)
     jump, steps = {}, {}
     for adhesion in (0.0, 4.0):
         r = rs.slosh.run(m, water, tank, motion, **kw, wall_adhesion=adhesion)
@@ -155,7 +155,7 @@ def test_the_explicit_stepper_stays_stable_with_critically_damped_walls():
     run, lateral load RMS within 0.7 %."""
     mesh, tank, water = small_tank()
     motion = rs.slosh.Motion().pulse("y", 2.0, 0.05, 0.35, ramp=0.05)
-    kw = dict(t_end=0.6, h=0.01, viscous_points=4, penalty_points=4, wall_damping_ratio=1.0)
+    kw = dict(t_end=0.6, step=0.01, viscous_points=4, penalty_points=4, wall_damping_ratio=1.0)
     imp = rs.slosh.run(mesh, water, tank, motion, **kw)
     exp = rs.slosh.run(mesh, water, tank, motion, **kw, stepper="explicit")
     assert exp["t"][-1] == pytest.approx(0.6) and exp["margins"]["worst_energy_error"] <= 0.01
@@ -181,3 +181,14 @@ def test_tank_geometry_constructors_and_the_deprecated_names():
         rs.slosh.cylinder_tank(10.0, 1.5, 0.5)
     with pytest.warns(DeprecationWarning, match="TankGeometry.elliptic"):
         rs.slosh.elliptic_tank(0.324, 0.2, 0.13)
+
+
+def test_the_old_name_h_of_the_step_still_works_and_warns():
+    # issue 18: one name for the step (`step`, as vehicle runs and scenes); `h` for one release
+    mesh = rs.mesh.box((0.4, 0.3, 0.1), (1, 1, 1))
+    water = rs.fluids.water(depth=0.1)
+    tank = rs.slosh.TankGeometry.box((-0.2, -0.15, 0.0), (0.2, 0.15, 0.3))
+    new = rs.slosh.run(mesh, water, tank, t_end=0.02, step=0.01)
+    with pytest.warns(DeprecationWarning, match="use `step`"):
+        old = rs.slosh.run(mesh, water, tank, t_end=0.02, h=0.01)
+    assert np.array_equal(old["force_tank"], new["force_tank"])

@@ -80,9 +80,9 @@ def test_slosh_run_resumed_from_its_checkpoint_continues_bitwise(tmp_path):
     motion = rs.slosh.Motion().pulse("y", 0.3 * 9.81, 0.0, 0.3)
     water = rs.fluids.water(depth=0.132)
     ck = tmp_path / "run.ckpt"
-    full = rs.slosh.run(mesh, water, tank, motion, t_end=0.6, h=0.004, checkpoint=ck, checkpoint_every=40)
+    full = rs.slosh.run(mesh, water, tank, motion, t_end=0.6, step=0.004, checkpoint=ck, checkpoint_every=40)
     assert ck.stat().st_size > 0
-    rest = rs.slosh.run(mesh, water, tank, motion, t_end=0.6, h=0.004, resume_from=ck)
+    rest = rs.slosh.run(mesh, water, tank, motion, t_end=0.6, step=0.004, resume_from=ck)
     k = int(np.flatnonzero(full["t"] == rest["t"][0])[0])
     assert 0 < k < len(full["t"]) - 1
     assert len(rest["t"]) == len(full["t"]) - k
@@ -90,9 +90,9 @@ def test_slosh_run_resumed_from_its_checkpoint_continues_bitwise(tmp_path):
         assert np.array_equal(rest[key], full[key][k:]), key
     assert np.array_equal(rest["newton_iterations"][1:], full["newton_iterations"][k + 1 :])
     with pytest.raises(ValueError, match="resume_from"):
-        rs.slosh.run(mesh, water, tank, motion, t_end=0.6, h=0.004, resume_from=tmp_path / "none.ckpt")
+        rs.slosh.run(mesh, water, tank, motion, t_end=0.6, step=0.004, resume_from=tmp_path / "none.ckpt")
     with pytest.raises(ValueError, match="checkpoint_every"):
-        rs.slosh.run(mesh, water, tank, motion, t_end=0.6, h=0.004, checkpoint=ck, checkpoint_every=0)
+        rs.slosh.run(mesh, water, tank, motion, t_end=0.6, step=0.004, checkpoint=ck, checkpoint_every=0)
 
 
 def test_explicit_slosh_run_resumed_from_its_checkpoint_continues_bitwise(tmp_path):
@@ -105,7 +105,7 @@ def test_explicit_slosh_run_resumed_from_its_checkpoint_continues_bitwise(tmp_pa
     motion = rs.slosh.Motion().pulse("y", 0.3 * rs.constants.GRAVITY, 0.0, 0.3)
     water = rs.fluids.water(depth=0.132)
     ck = tmp_path / "explicit.ckpt"
-    kw = dict(t_end=0.12, h=0.004, stepper="explicit")
+    kw = dict(t_end=0.12, step=0.004, stepper="explicit")
     full = rs.slosh.run(mesh, water, tank, motion, **kw, checkpoint=ck, checkpoint_every=400)
     assert ck.read_bytes()[:8] == b"RSLEXPCK"
     rest = rs.slosh.run(mesh, water, tank, motion, **kw, resume_from=ck)
@@ -114,7 +114,7 @@ def test_explicit_slosh_run_resumed_from_its_checkpoint_continues_bitwise(tmp_pa
     for key in ("t", "force_tank", "moment_tank", "com_tank", "volume", "kinetic_energy"):
         assert np.array_equal(rest[key], full[key][k:]), key
     with pytest.raises(ValueError, match="stepper"):
-        rs.slosh.run(mesh, water, tank, motion, t_end=0.12, h=0.004, stepper="implicit", resume_from=ck)
+        rs.slosh.run(mesh, water, tank, motion, t_end=0.12, step=0.004, stepper="implicit", resume_from=ck)
 
 
 def test_fluid_vehicle_runs_record_their_invariants_per_car_and_sample(tmp_path):

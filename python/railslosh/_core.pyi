@@ -159,7 +159,7 @@ class _SloshRequired(TypedDict):
     tank_shape: str
     tank_dims: list[float]
     t_end: float
-    h: float
+    step: float
 
 class SloshArgs(_SloshRequired, total=False):
     """The scenario of ``run_slosh`` (``railslosh.slosh.run`` builds it); a key left out or ``None``

@@ -135,7 +135,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
         f"({run_mesh.n_coords} coordinates), HHT, penalty wall contact"
     )
     t0 = time.perf_counter()
-    res = rs.slosh.run(run_mesh, oil, tank, motion, t_end=args.t_end, h=0.01)
+    res = rs.slosh.run(run_mesh, oil, tank, motion, t_end=args.t_end, step=0.01)
     wall = time.perf_counter() - t0
     m = rs.FluidBody(run_mesh, oil).total_mass
     fx = res["force_tank"][:, 0]

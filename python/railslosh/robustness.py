@@ -74,7 +74,7 @@ def _slosh(axis: str, value: Any, **kw: Any) -> Case:
         "power_index": 1.0,
         "penalty_factor": 1.0,
         "contact_factor": 1.0,
-        "h": 0.01,
+        "step": 0.01,
         "t_end": 0.25,
         "accel": (0.0, 0.3 * G, 0.0),
         "counts": (2, 3, 2),
@@ -131,7 +131,7 @@ def cases(form: str = "quick") -> list[Case]:
     out += [_slosh("fill", v, fill=v) for v in fills]
     steps = [1e-5, 1e-4, 1e-3, 1e-2] if full else [1e-5, 1e-2]
     # Small steps: a fixed number of steps (300) rather than a fixed duration.
-    out += [_slosh("time_step", v, h=v, t_end=min(0.25, 300 * v)) for v in steps]
+    out += [_slosh("time_step", v, step=v, t_end=min(0.25, 300 * v)) for v in steps]
     pen = [0.01, 0.1, 1.0, 10.0, 100.0] if full else [0.01, 100.0]
     out += [_slosh("penalty_factor", v, penalty_factor=v) for v in pen]
     out += [_slosh("contact_penalty_factor", v, contact_factor=v) for v in pen]
@@ -145,7 +145,7 @@ def cases(form: str = "quick") -> list[Case]:
         out.append(_slosh("impact_g", "30-penalty-x100", accel=(-30 * G, 0.0, 0.0), t_end=0.1, penalty_factor=100.0))
     if full:
         # Combined extremes.
-        out.append(_slosh("combined", "viscous-low-fill-big-step", viscosity=1e4, fill=0.1, h=0.01))
+        out.append(_slosh("combined", "viscous-low-fill-big-step", viscosity=1e4, fill=0.1, step=0.01))
         out.append(
             _slosh("combined", "bingham-full-soft", yield_stress=1e3, viscosity=0.1, fill=0.9, penalty_factor=0.01)
         )
@@ -260,7 +260,7 @@ def _run_slosh(kw: dict[str, Any]) -> tuple[dict[str, Any], float]:
         tank,
         motion,
         t_end=kw["t_end"],
-        h=kw["h"],
+        step=kw["step"],
         frame=kw["frame"],
         contact_stiffness_factor=kw["contact_factor"],
         viscous_points=vp,

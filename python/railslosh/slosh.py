@@ -4,7 +4,7 @@
     >>> mesh = rs.mesh.box((0.416, 0.324, 0.132), (3, 6, 2))
     >>> tank = rs.slosh.TankGeometry.box((-0.208, -0.162, 0.0), (0.208, 0.162, 0.3))
     >>> motion = rs.slosh.Motion().pulse("y", 0.3 * rs.constants.GRAVITY, 0.0, 0.5)
-    >>> res = rs.slosh.run(mesh, rs.fluids.water(depth=0.132), tank, motion, t_end=2.0, h=0.004,
+    >>> res = rs.slosh.run(mesh, rs.fluids.water(depth=0.132), tank, motion, t_end=2.0, step=0.004,
     ...                    viscous_points=4, penalty_points=4, contact_points_per_edge=4,
     ...                    wall_damping_ratio=1.0, wall_adhesion=4.0)  # clean loads (README)
     >>> res["force_tank"].shape  # (steps + 1, 3): load of the fluid on the tank, tank axes
@@ -143,7 +143,7 @@ def run(
     motion: Motion | None = None,
     *,
     t_end: float,
-    h: float = 0.01,
+    step: float = 0.01,
     frame: str = "inertial",
     gravity: tuple[float, float, float] = (0.0, 0.0, -GRAVITY),
     progress: ProgressArg = None,
@@ -161,8 +161,11 @@ def run(
     wall_damping_ratio: float = _core.WALL_DAMPING_RATIO,
     snapshot_every: float = 0.0,
     wall_adhesion: float = 0.0,
+    h: float | None = None,
 ) -> dict:
-    """Integrate the fluid in the moving tank up to `t_end` with steps of at most `h`.
+    """Integrate the fluid in the moving tank up to `t_end` with steps of at most `step` (s; every
+    step is recorded). ``h`` is the old name of ``step``, deprecated (one name for the step across
+    the API, scenes and ``run.json``: ``step``); it warns and will be removed.
 
     `frame="inertial"` moves the walls; `frame="tank"` solves in the tank frame with the
     pseudo-forces of seed 003 (appendix C, eq. 7.40). Returns a dict of numpy arrays
@@ -201,7 +204,7 @@ def run(
     ``stepper``: ``"implicit"`` (HHT-alpha, Newton on the sparse system; default), ``"explicit"``
     (central differences with the fluid's constant mass factored once: one force evaluation and a
     triangular solve per sub-step, sub-stepped at 0.8 of the stable step estimated by power
-    iteration, landing on every step ``h``; invariants checked at every ``h``) or ``"auto"`` (the
+    iteration, landing on every ``step``; invariants checked at every ``step``) or ``"auto"`` (the
     cheaper one from the stable step at the start). The results carry ``stepper`` and
     ``stepper_reason``; for the explicit stepper ``newton_iterations`` counts its sub-steps.
     Checkpoints need the implicit stepper.
@@ -223,6 +226,13 @@ def run(
     ``connectivity`` the element-node table, which :func:`railslosh.results.write_vtu` writes for
     ParaView.
     """
+    if h is not None:
+        warnings.warn(
+            "`h` of railslosh.slosh.run is deprecated: use `step` (the name of the step in vehicle runs and scenes)",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        step = h
     wall_damping_ratio = limits.check("wall_damping_ratio", wall_damping_ratio)
     wall_adhesion = limits.check("wall_adhesion", wall_adhesion)
     motion = motion or Motion()
@@ -239,7 +249,7 @@ def run(
             rotation_axis=motion.rotation_axis,
             angular_acceleration=motion.angular_acceleration,
             t_end=t_end,
-            h=h,
+            step=step,
             frame=frame,
             gravity=list(gravity),
             volume_tolerance=volume_tolerance,

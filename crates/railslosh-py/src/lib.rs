@@ -496,7 +496,7 @@ impl PyFluidBody {
 ///
 /// `scenario` is one dict (the stubs' `SloshArgs`): the tank `tank_shape` with its `tank_dims`
 /// and `bulkheads`, the motion (`acceleration` per axis x, y, z, `rotation_axis`,
-/// `angular_acceleration`), `t_end` and the recorded step `h`, and the model settings; keys left
+/// `angular_acceleration`), `t_end` and the largest step `step` (every step recorded), and the model settings; keys left
 /// out take `rail_mbs::slosh::SloshScenario::new`'s defaults, and an unknown key is an error.
 /// Returns a dict of numpy arrays (`t`, `force_tank`, `moment_tank`, `force_global`,
 /// `moment_global`, `com_tank`, `volume`, `kinetic_energy`, `potential_energy`,
@@ -538,12 +538,12 @@ fn run_slosh<'py>(
             ));
         }
     };
-    let (t_end, h): (f64, f64) = (a.req("t_end")?, a.req("h")?);
+    let (t_end, h): (f64, f64) = (a.req("t_end")?, a.req("step")?);
     if !(t_end.is_finite() && t_end > 0.0) {
         return Err(bad("t_end", t_end.to_string(), "a finite number > 0"));
     }
     if !(h.is_finite() && h > 0.0 && h <= t_end) {
-        return Err(bad("h", h.to_string(), "a finite number in (0, t_end]"));
+        return Err(bad("step", h.to_string(), "a finite number in (0, t_end]"));
     }
     let snapshot_every: f64 = a.opt("snapshot_every")?.unwrap_or(0.0);
     if !(snapshot_every.is_finite() && snapshot_every >= 0.0) {

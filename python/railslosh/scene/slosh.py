@@ -147,7 +147,7 @@ class SloshScene:
         fluid = spec.make_fluid(depth, depth / spec.counts[2], heads)
         kw: dict[str, Any] = {
             "t_end": self.t_end,
-            "h": self.step,
+            "step": self.step,
             "frame": self.frame,
             "viscous_points": self.viscous_points,
             "penalty_points": self.penalty_points,
