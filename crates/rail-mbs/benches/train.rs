@@ -19,8 +19,9 @@
 //! (`always_scan = false`) and a coarser scan. `evaluate` is also timed for every wheel of
 //! the train at the end of the curve and of the tangent run. It then counts the contact
 //! evaluations of a step: each residual evaluates every wheel once, each Jacobian
-//! evaluation 1 + 14 times (forward differences over the 7 coordinates and 7
-//! velocities of the wheelset, see `Multibody::force_jacobians`), and gives the
+//! evaluation once with the full search and 14 times warm-started
+//! (`WheelRailContact::evaluate_perturbed`, the forward differences over the 7 coordinates
+//! and 7 velocities of the wheelset, see `Multibody::force_jacobians`), and gives the
 //! contact cost per wheel per step and its share of the wall time.
 //!
 //! Arguments: `quick` (0.3 s simulated, 1 repeat), `sim=<s>` (default 1.0),
@@ -245,6 +246,13 @@ fn main() {
     let t_warm = time_calls(calls, || {
         black_box(warm.evaluate(black_box(&pose)).expect("contact"));
     });
+    // a Jacobian column's evaluation at a pose 1e-7 m away (as Multibody::force_jacobians)
+    let mut column = wheel.clone();
+    column.evaluate(&pose).expect("contact");
+    let moved = WheelPose { position: pose.position + nalgebra::Vector3::new(0.0, 1e-7, 0.0), ..pose };
+    let t_perturbed = time_calls(calls, || {
+        black_box(column.evaluate_perturbed(black_box(&moved)).expect("contact"));
+    });
     let mut coarse = wheel.clone();
     coarse.settings.scan_points = 100;
     let n_coarse = coarse.evaluate(&pose).expect("contact").len();
@@ -265,13 +273,16 @@ fn main() {
         mb.forces(t, &q, &v, &mut f).expect("forces");
     });
 
-    // Per wheel and step: one evaluation per residual, 1 + 14 per Jacobian evaluation,
-    // one per recorded sample.
+    // Per wheel and step: one full evaluation per residual, per Jacobian evaluation and per
+    // recorded sample, and 14 warm-started ones per Jacobian evaluation.
     let steps = stats.steps.max(1) as f64;
     let samples = (sim / 0.01).round() + 1.0;
-    let per_step = (stats.residual_evaluations as f64 + 15.0 * stats.jacobian_evaluations as f64 + samples) / steps;
+    let jacobians = stats.jacobian_evaluations as f64;
+    let per_step = (stats.residual_evaluations as f64 + jacobians + samples) / steps;
+    let perturbed_per_step = 14.0 * jacobians / steps;
     let wall_per_step = wall / steps;
-    let contact_per_wheel_step = per_step * mean_wheel;
+    let contact_per_wheel_step = per_step * mean_wheel + perturbed_per_step * t_perturbed;
+    let jacobian_contact = mean_wheel + 14.0 * t_perturbed;
     println!();
     println!(
         "contact search at the end of the median curve run (t = {t:.2} s), median of {calls} calls \
@@ -286,6 +297,7 @@ fn main() {
     row("  WheelRailContact::find_geometry (scan every call)", us(t_geo));
     row("  WheelRailContact::newton from the converged point", us(t_newton));
     row("  evaluate, warm start only (always_scan = false)", us(t_warm));
+    row("  evaluate_perturbed (a Jacobian column, 1e-7 m away)", us(t_perturbed));
     row(&format!("  evaluate, scan_points 100 instead of 200 ({n_coarse} points)"), us(t_coarse));
     row(
         &format!("all {wheels} wheels: evaluate mean (min-max); {two_point} with 2 points"),
@@ -298,14 +310,12 @@ fn main() {
     row(&format!("Multibody::forces ({dof} DOF, {wheels} wheels)"), format!("{:.2} ms", 1e3 * t_forces));
     row("Multibody::force_jacobians", format!("{:.2} ms", 1e3 * t_jac));
     row(
-        &format!("  contact share of force_jacobians ({wheels} x 15 evaluations)"),
-        format!("{:.0} %", 100.0 * wheels as f64 * 15.0 * mean_wheel / t_jac),
+        &format!("  contact share of force_jacobians ({wheels} x (1 full + 14 perturbed))"),
+        format!("{:.0} %", 100.0 * wheels as f64 * jacobian_contact / t_jac),
     );
-    row("contact evaluations per wheel per step", format!("{per_step:.2}"));
-    row(
-        "  of which for Jacobians (15 per Jacobian evaluation)",
-        format!("{:.2}", 15.0 * stats.jacobian_evaluations as f64 / steps),
-    );
+    row("full contact evaluations per wheel per step", format!("{per_step:.2}"));
+    row("  of which for Jacobians (1 per Jacobian evaluation)", format!("{:.2}", jacobians / steps));
+    row("perturbed evaluations per wheel per step (14 per Jacobian)", format!("{perturbed_per_step:.2}"));
     row("contact cost per wheel per step", us(contact_per_wheel_step));
     row("wall time per step (median curve run)", format!("{:.2} ms", 1e3 * wall_per_step));
     row(

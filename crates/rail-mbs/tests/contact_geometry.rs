@@ -9,7 +9,8 @@ use rail_mbs::track::{Side, Track, TrackPoint};
 mod common;
 use common::contact::{height_for_load, s1002_on_uic60};
 use rail_mbs::wheel_rail::{
-    ContactMethod, Material, RailGeometry, RailPath, WheelGeometry, WheelPose, WheelRailContact, combined_modulus,
+    ContactMethod, ContactPoint, Material, RailGeometry, RailPath, WheelGeometry, WheelPose, WheelRailContact,
+    combined_modulus,
 };
 
 fn rot_z(a: f64) -> Matrix3<f64> {
@@ -364,4 +365,48 @@ fn conformal_contact_at_the_flange_root_has_a_continuous_force_close_to_kik_piot
     );
     assert!(conformal >= 30, "{conformal} conformal poses");
     assert!(worst_kp < 0.2, "{worst_kp}");
+}
+
+/// A Jacobian column's evaluation (`evaluate_perturbed`: Newton from the last solutions, no
+/// scan) finds the same points and forces as the full search at the perturbed pose, in tread,
+/// two-point and flange contact, and leaves the warm start of the next evaluation as it was.
+#[test]
+fn a_perturbed_evaluation_matches_the_full_search_and_keeps_the_warm_start() {
+    let mut c = s1002_on_uic60(Side::Right, RailPath::Straight { inward_cant: 1.0 / 40.0 });
+    let mut full = s1002_on_uic60(Side::Right, RailPath::Straight { inward_cant: 1.0 / 40.0 });
+    let mut points_seen = Vec::new();
+    for y in [0.003, -0.0049, -0.0054, -0.0062, -0.008] {
+        let base = WheelPose::at_rest(Vector3::new(0.0, y, 0.46), Matrix3::identity());
+        let z = height_for_load(&mut c, &base, 4e4, 0.01);
+        let mut pose = WheelPose { position: Vector3::new(0.0, y, z), ..base };
+        pose.velocity = Vector3::new(10.0, 0.01, 0.0);
+        pose.angular_velocity = Vector3::new(0.0, 10.0 / 0.46, 0.0);
+        let at_base: Vec<ContactPoint> = c.evaluate(&pose).unwrap();
+        let warm_start = c.previous_solutions().to_vec();
+        let mut twin = c.clone();
+        points_seen.push(at_base.len());
+        // perturbations of the size of the Jacobian's difference steps, each coordinate
+        for d in [Vector3::new(1e-7, 0.0, 0.0), Vector3::new(0.0, 1e-7, 0.0), Vector3::new(0.0, 0.0, -1e-7)] {
+            let moved = WheelPose { position: pose.position + d, ..pose };
+            let a = c.evaluate_perturbed(&moved).unwrap().to_vec();
+            assert_eq!(c.previous_solutions(), &warm_start[..], "the warm start is left as it was");
+            let b = full.evaluate(&moved).unwrap();
+            assert_eq!(a.len(), b.len(), "y = {y}: the same points");
+            for (p, q) in a.iter().zip(&b) {
+                let f = q.force_on_wheel().norm();
+                assert!((p.force_on_wheel() - q.force_on_wheel()).norm() < 1e-9 * f, "y = {y}: force");
+                assert!((p.point() - q.point()).norm() < 1e-9, "y = {y}: point");
+            }
+        }
+        // the next evaluation (the next Newton iterate's pose) is the one it would have been
+        // without the perturbed ones, bit for bit
+        let next = WheelPose { position: pose.position + Vector3::new(1e-5, -2e-6, 1e-6), ..pose };
+        let (a, b) = (c.evaluate(&next).unwrap(), twin.evaluate(&next).unwrap());
+        assert_eq!(a.len(), b.len());
+        for (p, q) in a.iter().zip(&b) {
+            assert_eq!(p.force_on_wheel(), q.force_on_wheel(), "y = {y}: bit for bit");
+        }
+    }
+    println!("points at y = 3, -4.9, -5.4, -6.2, -8 mm: {points_seen:?}");
+    assert!(points_seen.contains(&2), "a two-point contact is among the cases: {points_seen:?}");
 }

@@ -26,6 +26,7 @@ use super::force::{ForceElement, Wrench};
 use super::joint::{Joint, JointKind};
 use super::wheelset::{WheelsetContact, WheelsetReport};
 use crate::integrator::{KktIndex, MechanicalSystem, SparsityPattern, SystemError};
+use crate::wheel_rail::ContactError;
 use ancf_core::error::{AncfError, invalid};
 
 /// Finite-difference step for coordinates (m, or Euler-parameter units).
@@ -344,9 +345,22 @@ impl Multibody {
     }
 
     fn wheelset_forces(&mut self, k: usize, q: &[f64], v: &[f64]) -> Result<[f64; 7], SystemError> {
+        self.wheelset_forces_with(k, q, v, WheelsetContact::wrench)
+    }
+
+    /// [`Self::wheelset_forces`] with the contact evaluated by `wrench` (the full search, or
+    /// the warm-started one of a Jacobian column, [`WheelsetContact::wrench_perturbed`]).
+    fn wheelset_forces_with(
+        &mut self,
+        k: usize,
+        q: &[f64],
+        v: &[f64],
+        wrench: fn(&mut WheelsetContact, &BodyState) -> Result<Wrench, ContactError>,
+    ) -> Result<[f64; 7], SystemError> {
         let s = self.state(Some(self.wheelsets[k].body), q, v);
         let w = &mut self.wheelsets[k];
-        let wr: Wrench = w.wrench(&s).map_err(|e| SystemError::Other(format!("wheelset contact '{}': {e}", w.name)))?;
+        let wr: Wrench =
+            wrench(w, &s).map_err(|e| SystemError::Other(format!("wheelset contact '{}': {e}", w.name)))?;
         Ok(s.generalized(&wr.force, &wr.moment))
     }
 
@@ -365,14 +379,16 @@ impl Multibody {
         let mut jv = [[0.0; 14]; 14];
         for k in 0..self.wheelsets.len() {
             let b = self.wheelsets[k].body.0;
+            // the full search at (q, v); the columns warm-start from its points
             let f0 = self.wheelset_forces(k, q, v)?;
+            let perturbed = WheelsetContact::wrench_perturbed;
             for c in 0..7 {
                 let g = 7 * b + c;
                 qq[g] = q[g] + FD_Q;
-                let fp = self.wheelset_forces(k, qq, vv)?;
+                let fp = self.wheelset_forces_with(k, qq, vv, perturbed)?;
                 qq[g] = q[g];
                 vv[g] = v[g] + FD_V;
-                let gp = self.wheelset_forces(k, qq, vv)?;
+                let gp = self.wheelset_forces_with(k, qq, vv, perturbed)?;
                 vv[g] = v[g];
                 for r in 0..7 {
                     jq[r][c] = (fp[r] - f0[r]) / FD_Q;

@@ -48,10 +48,25 @@ impl WheelsetContact {
     /// Total contact wrench on the wheelset about its centre of mass (no allocation once
     /// the contacts' buffers have grown).
     pub fn wrench(&mut self, state: &BodyState) -> Result<Wrench, ContactError> {
+        self.wrench_with(state, WheelRailContact::evaluate_cached)
+    }
+
+    /// [`Self::wrench`] at a state within a finite-difference perturbation of the last one
+    /// evaluated, for a Jacobian column: the search warm-starts from the last solutions and
+    /// leaves them as they were ([`WheelRailContact::evaluate_perturbed`]).
+    pub fn wrench_perturbed(&mut self, state: &BodyState) -> Result<Wrench, ContactError> {
+        self.wrench_with(state, WheelRailContact::evaluate_perturbed)
+    }
+
+    fn wrench_with(
+        &mut self,
+        state: &BodyState,
+        evaluate: for<'a> fn(&'a mut WheelRailContact, &WheelPose) -> Result<&'a [ContactPoint], ContactError>,
+    ) -> Result<Wrench, ContactError> {
         let p = pose(state);
         let mut w = Wrench::default();
         for wheel in &mut self.wheels {
-            for c in wheel.evaluate_cached(&p)? {
+            for c in evaluate(wheel, &p)? {
                 w.force += c.force_on_wheel();
                 w.moment += c.moment_on_wheel(&state.position);
             }

@@ -400,6 +400,9 @@ pub struct WheelRailContact {
     /// Search settings.
     pub settings: ContactSettings,
     previous: Vec<[f64; 4]>,
+    /// Whether every point of `previous` is a converged, convex Newton solution (none a scan
+    /// fall-back): only then can [`Self::evaluate_perturbed`] start from them alone.
+    previous_exact: bool,
     last_station: Option<f64>,
     /// Reusable buffers of the search (no allocation per call once sized).
     scratch: SearchScratch,
@@ -416,6 +419,8 @@ struct SearchScratch {
     geometry: Vec<ContactGeometry>,
     /// Loaded points of the latest [`WheelRailContact::evaluate_cached`].
     points: Vec<ContactPoint>,
+    /// The warm start kept across [`WheelRailContact::evaluate_perturbed`].
+    saved_previous: Vec<[f64; 4]>,
 }
 
 impl WheelRailContact {
@@ -434,6 +439,7 @@ impl WheelRailContact {
             damping: 0.0,
             settings: ContactSettings::default(),
             previous: Vec::new(),
+            previous_exact: false,
             last_station: None,
             scratch: SearchScratch::default(),
         }
@@ -442,6 +448,7 @@ impl WheelRailContact {
     /// Forgets the warm-start state.
     pub fn reset(&mut self) {
         self.previous.clear();
+        self.previous_exact = false;
         self.last_station = None;
     }
 
@@ -947,8 +954,7 @@ impl WheelRailContact {
             }
             if ok {
                 self.dedup(out);
-                self.previous.clear();
-                self.previous.extend(out.iter().map(|g| g.params));
+                self.remember(out);
                 return Ok(());
             }
             out.clear();
@@ -998,9 +1004,49 @@ impl WheelRailContact {
         }
         (self.scratch.scan, self.scratch.seeds) = (vals, seeds);
         self.dedup(out);
-        self.previous.clear();
-        self.previous.extend(out.iter().map(|g| g.params));
+        self.remember(out);
         Ok(())
+    }
+
+    /// Keeps the points of a search as the warm start of the next one.
+    fn remember(&mut self, points: &[ContactGeometry]) {
+        self.previous.clear();
+        self.previous.extend(points.iter().map(|g| g.params));
+        self.previous_exact = points.iter().all(Self::exact);
+    }
+
+    /// A converged Newton solution with both relative curvatures positive (what the scan
+    /// path accepts without falling back to the refined scan point).
+    fn exact(g: &ContactGeometry) -> bool {
+        g.method == ContactMethod::Newton && g.curvature_x > 0.0 && g.curvature_y > 0.0
+    }
+
+    /// The points of `pose` found by Newton from each warm-start point alone, into `out`:
+    /// `false` (and `out` to be discarded) unless every one converges, stays on the profiles,
+    /// is exact ([`Self::exact`]) and lies within [`PERTURBED_POINT_MOVE`] of where it started.
+    fn follow_previous(&mut self, pose: &WheelPose, out: &mut Vec<ContactGeometry>) -> Result<bool, ContactError> {
+        out.clear();
+        if !self.previous_exact || self.previous.is_empty() {
+            return Ok(false);
+        }
+        let s0 = self.rail.station(&pose.position, self.last_station)?;
+        let fd0 = self.rail.frame_derivs(s0);
+        let (a0, b0) = Self::wheel_axes(pose, &fd0);
+        let lowest = Self::lowest_angle(&a0, &b0);
+        for k in 0..self.previous.len() {
+            let p = self.previous[k];
+            let Ok(q) = self.newton(pose, p) else { return Ok(false) };
+            let near = (q[1] - p[1]).abs() < PERTURBED_POINT_MOVE && (q[2] - p[2]).abs() < PERTURBED_POINT_MOVE;
+            if !(near && self.in_domain(&q, lowest)) {
+                return Ok(false);
+            }
+            let g = self.geometry_at(pose, q, ContactMethod::Newton);
+            if !Self::exact(&g) {
+                return Ok(false);
+            }
+            out.push(g);
+        }
+        Ok(true)
     }
 
     /// Keeps the deepest of points closer than the merge distance, then orders by `u`
@@ -1054,6 +1100,36 @@ impl WheelRailContact {
         self.previous.extend(previous);
         self.last_station = last_station;
         result
+    }
+
+    /// [`Self::evaluate_cached`] at a pose within a finite-difference perturbation of the last
+    /// evaluated one (a Jacobian column), leaving the warm start as it was. When every point
+    /// of the last search was an exact Newton solution, each is followed by Newton alone from
+    /// where it was; the search is the full one (as [`Self::evaluate_cached`]) when one of them
+    /// was a scan fall-back, or when following one fails, moves it more than
+    /// [`PERTURBED_POINT_MOVE`], takes it off the profiles or makes it non-convex. The points
+    /// followed are the stationary points of the gap the full search finds (to the Newton
+    /// tolerance), so the difference quotient keeps the forces' change with the pose; the
+    /// profile scan, the bulk of an evaluation, runs once per Jacobian instead of once per
+    /// column.
+    pub fn evaluate_perturbed(&mut self, pose: &WheelPose) -> Result<&[ContactPoint], ContactError> {
+        let (exact, last_station) = (self.previous_exact, self.last_station);
+        let mut saved = std::mem::take(&mut self.scratch.saved_previous);
+        saved.clear();
+        saved.extend_from_slice(&self.previous);
+        let (mut geoms, mut out) =
+            (std::mem::take(&mut self.scratch.geometry), std::mem::take(&mut self.scratch.points));
+        let result = self
+            .follow_previous(pose, &mut geoms)
+            .and_then(|followed| if followed { Ok(()) } else { self.find_geometry_into(pose, &mut geoms) })
+            .and_then(|()| self.loaded_points(pose, &geoms, None, &mut out));
+        (self.scratch.geometry, self.scratch.points) = (geoms, out);
+        self.previous_exact = exact;
+        self.last_station = last_station;
+        self.previous.clear();
+        self.previous.extend_from_slice(&saved);
+        self.scratch.saved_previous = saved;
+        result.map(|()| self.scratch.points.as_slice())
     }
 
     /// [`Self::evaluate`] into a buffer of the contact, allocating nothing once the
@@ -1227,6 +1303,12 @@ pub const CONFORMAL_CURVATURE_RATIO: f64 = 0.1;
 /// the parabola with the rigid interpenetration region's width
 /// ([`WheelRailContact::lateral_curvature`]).
 pub const CONFORMAL_REGION_FACTOR: f64 = 0.5;
+
+/// How far a contact point may move (rail and wheel lateral coordinates) under a Jacobian
+/// column's perturbation and still be followed by Newton alone
+/// ([`WheelRailContact::evaluate_perturbed`]), m. The perturbations move a point by about their
+/// own size (1e-7 m); a larger move means another point of the gap, found by the full search.
+pub const PERTURBED_POINT_MOVE: f64 = 1e-4;
 
 /// Half-width of the separation sampled for a Kik–Piotrowski patch, m.
 pub const KP_SEPARATION_HALF_WIDTH: f64 = 0.025;
