@@ -71,7 +71,7 @@ impl TrainRecord {
     }
 
     /// Column names of [`Self::row`] for a train with `wheelsets` wheelsets, `couplers`
-    /// couplers and `cars` cars (the layout of a results stream, `run_train_streamed`).
+    /// couplers and `cars` cars (the layout of the rows a [`super::run_vehicle`] sink receives).
     pub fn columns(wheelsets: usize, couplers: usize, cars: usize) -> Vec<String> {
         let mut c = vec!["t".to_string()];
         for w in 0..wheelsets {
