@@ -276,13 +276,13 @@ impl PySloshParticipant {
         loads_py(py, self.inner.loads())
     }
 
-    /// Current time (s).
     /// Magnitude of gravity of the default input and the rest state, m/s².
     #[getter]
     fn gravity(&self) -> f64 {
         self.inner.gravity()
     }
 
+    /// Current time (s).
     #[getter]
     fn time(&self) -> f64 {
         self.inner.time()
