@@ -242,3 +242,17 @@ def test_the_slosh_kernel_takes_one_scenario_dict_and_names_a_bad_key_in_it():
     assert res["error"] is None
     assert res["t"][-1] == pytest.approx(0.01)
     assert np.all(np.diff(res["t"]) <= 0.005 + 1e-12)
+
+
+def test_a_wrongly_typed_number_of_the_fluid_constructor_is_named_in_the_message():
+    # PyO3 names a constructor's argument only in an exception note; the Fluid constructor, which
+    # every railslosh.fluids function calls, names it in the message itself
+    with pytest.raises(TypeError) as info:
+        rs.fluids.newtonian(1000.0, "thin")
+    assert str(info.value).startswith("invalid `viscosity` = 'thin': "), str(info.value)
+    with pytest.raises(TypeError, match=r"^invalid `density` = 'heavy': "):
+        rs.Fluid("heavy", "newtonian", viscosity=1e-3, bulk_penalty=1e6)
+    with pytest.raises(TypeError, match=r"^invalid `elastic_modulus` = 'stiff': "):
+        rs.Fluid(870.0, "oldroyd", viscosity=1.0, yield_stress=1.0, elastic_modulus="stiff", bulk_penalty=1e6)
+    # optional numbers still take None as not given
+    assert rs.Fluid(870.0, "oldroyd", viscosity=1.0, yield_stress=1.0, elastic_modulus=None, bulk_penalty=1e6)

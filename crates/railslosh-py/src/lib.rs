@@ -272,6 +272,36 @@ struct PyFluid {
     inner: Fluid,
 }
 
+/// A number argument of a class constructor, read with an error that names it: PyO3 names a
+/// constructor's argument only in an exception note, which `str(error)` leaves out (functions
+/// get the name from `railslosh.limits.name_native_arguments`; classes cannot be wrapped).
+fn named_number(name: &str, obj: &Bound<'_, PyAny>) -> PyResult<f64> {
+    obj.extract::<f64>().map_err(|e| {
+        let shown = obj.repr().map_or_else(|_| "?".to_string(), |r| r.to_string());
+        pyo3::exceptions::PyTypeError::new_err(format!("invalid `{name}` = {shown}: {}", e.value(obj.py())))
+    })
+}
+
+/// `from_py_with` readers of the `Fluid` constructor's number arguments, one per name (the
+/// optional ones take `None` as not given).
+macro_rules! fluid_numbers {
+    ($($name:ident),*; $($optional:ident),*) => {
+        mod fluid_arg {
+            use super::*;
+            $(pub(super) fn $name(obj: &Bound<'_, PyAny>) -> PyResult<f64> {
+                named_number(stringify!($name), obj)
+            })*
+            $(pub(super) fn $optional(obj: &Bound<'_, PyAny>) -> PyResult<Option<f64>> {
+                if obj.is_none() { Ok(None) } else { named_number(stringify!($optional), obj).map(Some) }
+            })*
+        }
+    };
+}
+fluid_numbers!(
+    density, viscosity, yield_stress, power_index, bulk_penalty, bulk_damping, shear_rate_reg, shear_stabilization;
+    consistency, elastic_modulus
+);
+
 #[pymethods]
 impl PyFluid {
     #[new]
@@ -280,17 +310,17 @@ impl PyFluid {
                         shear_stabilization=0.0))]
     #[allow(clippy::too_many_arguments)]
     fn new(
-        density: f64,
+        #[pyo3(from_py_with = fluid_arg::density)] density: f64,
         model: &str,
-        viscosity: f64,
-        yield_stress: f64,
-        consistency: Option<f64>,
-        power_index: f64,
-        elastic_modulus: Option<f64>,
-        bulk_penalty: f64,
-        bulk_damping: f64,
-        shear_rate_reg: f64,
-        shear_stabilization: f64,
+        #[pyo3(from_py_with = fluid_arg::viscosity)] viscosity: f64,
+        #[pyo3(from_py_with = fluid_arg::yield_stress)] yield_stress: f64,
+        #[pyo3(from_py_with = fluid_arg::consistency)] consistency: Option<f64>,
+        #[pyo3(from_py_with = fluid_arg::power_index)] power_index: f64,
+        #[pyo3(from_py_with = fluid_arg::elastic_modulus)] elastic_modulus: Option<f64>,
+        #[pyo3(from_py_with = fluid_arg::bulk_penalty)] bulk_penalty: f64,
+        #[pyo3(from_py_with = fluid_arg::bulk_damping)] bulk_damping: f64,
+        #[pyo3(from_py_with = fluid_arg::shear_rate_reg)] shear_rate_reg: f64,
+        #[pyo3(from_py_with = fluid_arg::shear_stabilization)] shear_stabilization: f64,
     ) -> PyResult<Self> {
         let rheology = match model {
             "newtonian" => Rheology::Newtonian { viscosity },
