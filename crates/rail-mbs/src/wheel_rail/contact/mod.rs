@@ -419,7 +419,8 @@ struct SearchScratch {
     geometry: Vec<ContactGeometry>,
     /// Loaded points of the latest [`WheelRailContact::evaluate_cached`].
     points: Vec<ContactPoint>,
-    /// The warm start kept across [`WheelRailContact::evaluate_perturbed`].
+    /// The warm start kept across an observation or a Jacobian column
+    /// (`WheelRailContact::keeping_warm_start`).
     saved_previous: Vec<[f64; 4]>,
 }
 
@@ -930,16 +931,7 @@ impl WheelRailContact {
     /// buffers have grown.
     fn find_geometry_into(&mut self, pose: &WheelPose, out: &mut Vec<ContactGeometry>) -> Result<(), ContactError> {
         out.clear();
-        if !(pose.position.iter().all(|x| x.is_finite()) && pose.rotation.iter().all(|x| x.is_finite())) {
-            return Err(ContactError::InvalidInput("non-finite wheel pose".into()));
-        }
-        let s0 = self.rail.station(&pose.position, self.last_station)?;
-        self.last_station = Some(s0);
-        // the rail frame at the wheel's station: the scan's, and where the lowest point of the
-        // wheel (the reference of the wheel angle bound) is
-        let fd0 = self.rail.frame_derivs(s0);
-        let (a0, b0) = Self::wheel_axes(pose, &fd0);
-        let lowest = Self::lowest_angle(&a0, &b0);
+        let (s0, fd0, lowest) = self.locate(pose)?;
         // Warm start only.
         if !self.settings.always_scan && !self.previous.is_empty() {
             let mut ok = true;
@@ -1008,6 +1000,20 @@ impl WheelRailContact {
         Ok(())
     }
 
+    /// The wheel's station on the rail (kept as the station's warm start), the rail frame there
+    /// (the scan's) and the wheel angle of the lowest point of the wheel's circles (the
+    /// reference of the wheel angle bound, [`Self::in_domain`]).
+    fn locate(&mut self, pose: &WheelPose) -> Result<(f64, RailFrameDerivs, f64), ContactError> {
+        if !(pose.position.iter().all(|x| x.is_finite()) && pose.rotation.iter().all(|x| x.is_finite())) {
+            return Err(ContactError::InvalidInput("non-finite wheel pose".into()));
+        }
+        let s0 = self.rail.station(&pose.position, self.last_station)?;
+        self.last_station = Some(s0);
+        let fd0 = self.rail.frame_derivs(s0);
+        let (a0, b0) = Self::wheel_axes(pose, &fd0);
+        Ok((s0, fd0, Self::lowest_angle(&a0, &b0)))
+    }
+
     /// Keeps the points of a search as the warm start of the next one.
     fn remember(&mut self, points: &[ContactGeometry]) {
         self.previous.clear();
@@ -1029,10 +1035,7 @@ impl WheelRailContact {
         if !self.previous_exact || self.previous.is_empty() {
             return Ok(false);
         }
-        let s0 = self.rail.station(&pose.position, self.last_station)?;
-        let fd0 = self.rail.frame_derivs(s0);
-        let (a0, b0) = Self::wheel_axes(pose, &fd0);
-        let lowest = Self::lowest_angle(&a0, &b0);
+        let (_, _, lowest) = self.locate(pose)?;
         for k in 0..self.previous.len() {
             let p = self.previous[k];
             let Ok(q) = self.newton(pose, p) else { return Ok(false) };
@@ -1094,11 +1097,22 @@ impl WheelRailContact {
     /// (recording loads between steps) then cannot change the next force evaluation's
     /// search, so results do not depend on how often they are recorded.
     pub fn observe(&mut self, pose: &WheelPose) -> Result<Vec<ContactPoint>, ContactError> {
-        let (previous, last_station) = (self.previous.clone(), self.last_station);
-        let result = self.evaluate(pose);
-        self.previous.clear();
-        self.previous.extend(previous);
+        self.keeping_warm_start(|c| c.evaluate(pose))
+    }
+
+    /// Runs `f` and puts the search's warm start back as it was before: its points, whether
+    /// they are exact, and the station.
+    fn keeping_warm_start<T>(&mut self, f: impl FnOnce(&mut Self) -> T) -> T {
+        let (exact, last_station) = (self.previous_exact, self.last_station);
+        let mut saved = std::mem::take(&mut self.scratch.saved_previous);
+        saved.clear();
+        saved.extend_from_slice(&self.previous);
+        let result = f(self);
+        self.previous_exact = exact;
         self.last_station = last_station;
+        self.previous.clear();
+        self.previous.extend_from_slice(&saved);
+        self.scratch.saved_previous = saved;
         result
     }
 
@@ -1113,34 +1127,32 @@ impl WheelRailContact {
     /// profile scan, the bulk of an evaluation, runs once per Jacobian instead of once per
     /// column.
     pub fn evaluate_perturbed(&mut self, pose: &WheelPose) -> Result<&[ContactPoint], ContactError> {
-        let (exact, last_station) = (self.previous_exact, self.last_station);
-        let mut saved = std::mem::take(&mut self.scratch.saved_previous);
-        saved.clear();
-        saved.extend_from_slice(&self.previous);
-        let (mut geoms, mut out) =
-            (std::mem::take(&mut self.scratch.geometry), std::mem::take(&mut self.scratch.points));
-        let result = self
-            .follow_previous(pose, &mut geoms)
-            .and_then(|followed| if followed { Ok(()) } else { self.find_geometry_into(pose, &mut geoms) })
-            .and_then(|()| self.loaded_points(pose, &geoms, None, &mut out));
-        (self.scratch.geometry, self.scratch.points) = (geoms, out);
-        self.previous_exact = exact;
-        self.last_station = last_station;
-        self.previous.clear();
-        self.previous.extend_from_slice(&saved);
-        self.scratch.saved_previous = saved;
-        result.map(|()| self.scratch.points.as_slice())
+        let search = |c: &mut Self, pose: &WheelPose, out: &mut Vec<ContactGeometry>| {
+            if c.follow_previous(pose, out)? { Ok(()) } else { c.find_geometry_into(pose, out) }
+        };
+        self.keeping_warm_start(|c| c.evaluate_into_scratch(pose, search))?;
+        Ok(self.scratch.points.as_slice())
     }
 
     /// [`Self::evaluate`] into a buffer of the contact, allocating nothing once the
     /// buffers have grown; the points stay valid until the next call.
     pub fn evaluate_cached(&mut self, pose: &WheelPose) -> Result<&[ContactPoint], ContactError> {
+        self.evaluate_into_scratch(pose, Self::find_geometry_into)?;
+        Ok(self.scratch.points.as_slice())
+    }
+
+    /// The geometry of `pose` by `search`, then its loaded points, into the contact's buffers
+    /// (`scratch.geometry`, `scratch.points`), allocating nothing once they have grown.
+    fn evaluate_into_scratch(
+        &mut self,
+        pose: &WheelPose,
+        search: impl FnOnce(&mut Self, &WheelPose, &mut Vec<ContactGeometry>) -> Result<(), ContactError>,
+    ) -> Result<(), ContactError> {
         let (mut geoms, mut out) =
             (std::mem::take(&mut self.scratch.geometry), std::mem::take(&mut self.scratch.points));
-        let result =
-            self.find_geometry_into(pose, &mut geoms).and_then(|()| self.loaded_points(pose, &geoms, None, &mut out));
+        let result = search(self, pose, &mut geoms).and_then(|()| self.loaded_points(pose, &geoms, None, &mut out));
         (self.scratch.geometry, self.scratch.points) = (geoms, out);
-        result.map(|()| self.scratch.points.as_slice())
+        result
     }
 
     /// [`Self::evaluate`] with prescribed creepages (the same at every point, CONTACT's
