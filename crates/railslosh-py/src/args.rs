@@ -30,14 +30,7 @@ impl<'a, 'py> Args<'a, 'py> {
         if v.is_none() {
             return Ok(None);
         }
-        match v.extract::<T>() {
-            Ok(x) => Ok(Some(x)),
-            Err(e) => {
-                let e: PyErr = e.into();
-                let shown = v.repr().map_or_else(|_| "?".to_string(), |r| r.to_string());
-                Err(pyo3::exceptions::PyTypeError::new_err(format!("invalid `{key}` = {shown}: {}", e.value(v.py()))))
-            }
-        }
+        v.extract::<T>().map(Some).map_err(|e| named_type_error(key, &v, e.into()))
     }
 
     /// The value of `key`, which must be given.
@@ -60,4 +53,12 @@ impl<'a, 'py> Args<'a, 'py> {
         }
         Ok(())
     }
+}
+
+/// The `TypeError` of an argument `name` whose value `obj` has the wrong type (`error`, PyO3's),
+/// in the one form of input errors: ``invalid `t_end` = 'x': must be real number, not str``.
+/// PyO3 itself names the argument only in an exception note, which `str(error)` leaves out.
+pub(crate) fn named_type_error(name: &str, obj: &Bound<'_, PyAny>, error: PyErr) -> PyErr {
+    let shown = obj.repr().map_or_else(|_| "?".to_string(), |r| r.to_string());
+    pyo3::exceptions::PyTypeError::new_err(format!("invalid `{name}` = {shown}: {}", error.value(obj.py())))
 }

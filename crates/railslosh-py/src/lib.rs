@@ -272,14 +272,11 @@ struct PyFluid {
     inner: Fluid,
 }
 
-/// A number argument of a class constructor, read with an error that names it: PyO3 names a
-/// constructor's argument only in an exception note, which `str(error)` leaves out (functions
-/// get the name from `railslosh.limits.name_native_arguments`; classes cannot be wrapped).
+/// A number argument of a class constructor, read with an error that names it
+/// ([`args::named_type_error`]; functions get the name from
+/// `railslosh.limits.name_native_arguments`, classes cannot be wrapped that way).
 fn named_number(name: &str, obj: &Bound<'_, PyAny>) -> PyResult<f64> {
-    obj.extract::<f64>().map_err(|e| {
-        let shown = obj.repr().map_or_else(|_| "?".to_string(), |r| r.to_string());
-        pyo3::exceptions::PyTypeError::new_err(format!("invalid `{name}` = {shown}: {}", e.value(obj.py())))
-    })
+    obj.extract::<f64>().map_err(|e| args::named_type_error(name, obj, e))
 }
 
 /// `from_py_with` readers of the `Fluid` constructor's number arguments, one per name (the

@@ -13,8 +13,7 @@ use rail_mbs::profile::aar1b_wheel_approx;
 use rail_mbs::track::{Track, TrackPoint};
 use rail_mbs::vehicle::{
     BrakeScope, Cargo, EquivalentCargo, EquivalentModel, EquivalentTrainRecord, FluidCargo, FluidTrainRecord,
-    LoadFilter, Observer, RigidCargo, SampleSink, SloshAxis, TankCarParams, TrainRecord, TrainScenario, TruckModel,
-    run_vehicle,
+    LoadFilter, RigidCargo, SampleSink, SloshAxis, TankCarParams, TrainRecord, TrainScenario, TruckModel, run_vehicle,
 };
 
 use crate::args::Args;
@@ -322,8 +321,9 @@ fn train_scenario(d: &Bound<'_, PyDict>) -> PyResult<TrainScenario> {
 }
 
 /// Runs `sc` carrying `cargo` with the GIL released ([`rail_mbs::vehicle::run_vehicle`]):
-/// `progress` called as it goes, every recorded sample appended to the `stream` file. Returns
-/// the record as a dict (`to_dict`), with an `error` entry when the run stopped early.
+/// `progress` called as it goes and, when `stream` names a file, every recorded sample appended
+/// to it (layout [`Cargo::columns`]). Returns the record as a dict (`to_dict`), with an `error`
+/// entry when the run stopped early.
 fn run_cargo<'py, C: Cargo + Send + Sync>(
     py: Python<'py>,
     sc: TrainScenario,
@@ -334,14 +334,26 @@ fn run_cargo<'py, C: Cargo + Send + Sync>(
 where
     C::Record: Send,
 {
-    let columns = compute(py, || cargo.columns(&sc))?;
-    let run = move |obs: Observer<'_>, sink: SampleSink<'_>| {
-        Ok(match run_vehicle(&sc, &cargo, obs, Some(sink))? {
+    let mut observer = PyProgress::new(progress);
+    let obs = &mut observer;
+    let (record, error) = compute(py, move || {
+        let mut journal = match stream.as_deref() {
+            Some(path) => Some(open_stream(path, &cargo.columns(&sc)?)?),
+            None => None,
+        };
+        let mut append = |row: &[f64]| journal.as_mut().map_or(Ok(()), |j| j.append(row));
+        let sink: Option<SampleSink<'_>> = if stream.is_some() { Some(&mut append) } else { None };
+        Ok(match run_vehicle(&sc, &cargo, &mut |p| obs.observe(p), sink)? {
             Ok(r) => (r, None),
             Err(f) => (f.record, Some(f.error.to_string())),
         })
-    };
-    run_recorded(py, progress, stream, columns, run, to_dict)
+    })?;
+    observer.finish()?;
+    let d = to_dict(py, &record)?;
+    if let Some(e) = error {
+        d.set_item("error", e)?;
+    }
+    Ok(d)
 }
 
 /// Runs a train of rigid-lading tank cars (`train`: a `TrainArgs` dict; `lading_mass`,
@@ -359,43 +371,14 @@ pub fn run_train<'py>(
     run_cargo(py, sc, RigidCargo, (progress, stream), |py, r| record_dict(py, r))
 }
 
-/// Runs a train with the GIL released, `progress` called as it goes and every recorded
-/// sample appended to the `stream` file (layout `columns`); returns the record as a dict
-/// (`to_dict`), with an `error` entry when the run stopped early. `run` gets the observer and
-/// the sink and returns the record, and the error if it failed.
-fn run_recorded<'py, R: Send>(
-    py: Python<'py>,
-    progress: Option<Py<PyAny>>,
-    stream: Option<std::path::PathBuf>,
-    columns: Vec<String>,
-    run: impl FnOnce(Observer<'_>, SampleSink<'_>) -> Result<(R, Option<String>), AncfError> + Send,
-    to_dict: impl Fn(Python<'py>, &R) -> PyResult<Bound<'py, PyDict>>,
-) -> PyResult<Bound<'py, PyDict>> {
-    let mut observer = PyProgress::new(progress);
-    let obs = &mut observer;
-    let (record, error) = compute(py, move || {
-        let mut journal = open_stream(stream.as_deref(), &columns)?;
-        let mut sink = |row: &[f64]| journal.as_mut().map_or(Ok(()), |j| j.append(row));
-        run(&mut |p| obs.observe(p), &mut sink)
-    })?;
-    observer.finish()?;
-    let d = to_dict(py, &record)?;
-    if let Some(e) = error {
-        d.set_item("error", e)?;
-    }
-    Ok(d)
-}
-
 /// The results stream of a run (`stream=` path): every recorded sample is appended and
 /// flushed as it is computed, so an interrupted run keeps it (issue 8).
 fn open_stream(
-    path: Option<&std::path::Path>,
+    path: &std::path::Path,
     columns: &[String],
-) -> Result<Option<rail_mbs::integrator::Journal>, ancf_core::error::AncfError> {
-    let Some(path) = path else { return Ok(None) };
+) -> Result<rail_mbs::integrator::Journal, ancf_core::error::AncfError> {
     let names: Vec<&str> = columns.iter().map(String::as_str).collect();
     rail_mbs::integrator::Journal::create(path, &names, 1)
-        .map(Some)
         .map_err(|e| invalid("stream", path.display(), &format!("a writable file ({e})")))
 }
 
