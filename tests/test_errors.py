@@ -256,3 +256,41 @@ def test_a_wrongly_typed_number_of_the_fluid_constructor_is_named_in_the_message
         rs.Fluid(870.0, "oldroyd", viscosity=1.0, yield_stress=1.0, elastic_modulus="stiff", bulk_penalty=1e6)
     # optional numbers still take None as not given
     assert rs.Fluid(870.0, "oldroyd", viscosity=1.0, yield_stress=1.0, elastic_modulus=None, bulk_penalty=1e6)
+
+
+def test_every_class_constructor_names_a_bad_argument_in_the_message():
+    # issue 18: FluidBody, SloshParticipant and Track read each argument by name, as Fluid does: a
+    # wrong type is a TypeError, a value the type cannot hold (a negative count, a point of two
+    # coordinates) a ValueError, each naming the argument and its value
+    mesh = rs.mesh.box((0.4, 0.3, 0.1), (2, 2, 1))
+    water = rs.fluids.water(depth=0.1)
+    with pytest.raises(TypeError, match=r"^invalid `viscous_points` = '3': "):
+        rs.FluidBody(mesh, water, viscous_points="3")
+    with pytest.raises(ValueError, match=r"^invalid `mass_points` = -1: expected a non-negative integer"):
+        rs.FluidBody(mesh, water, mass_points=-1)
+    box = [0.0, 0.0, 0.0, 0.4, 0.3, 0.2]
+    with pytest.raises(TypeError, match=r"^invalid `h_max` = 'x': "):
+        _core.SloshParticipant(mesh, water, "box", box, h_max="x")
+    with pytest.raises(TypeError, match=r"^invalid `tank_dims` = 'abc': "):
+        _core.SloshParticipant(mesh, water, "box", "abc")
+    with pytest.raises(ValueError, match=r"^invalid `reference_point` = \[1, 2\]: expected a sequence of length 3"):
+        _core.SloshParticipant(mesh, water, "box", box, reference_point=[1, 2])
+    with pytest.raises(ValueError, match=r"^invalid `penalty_points` = -2: expected a non-negative integer"):
+        _core.SloshParticipant(mesh, water, "box", box, penalty_points=-2)
+    tangent = {"curvature": [0.0, 0.0], "superelevation": [0.0, 0.0]}
+    with pytest.raises(TypeError, match=r"^invalid `gauge` = 'wide': "):
+        rs.rail.Track([0.0, 100.0], **tangent, gauge="wide")
+    with pytest.raises(ValueError, match=r"^invalid `origin` = \(0, 0\): expected a sequence of length 3"):
+        rs.rail.Track([0.0, 100.0], **tangent, origin=(0, 0))
+    # what each reads well still builds: an integer gauge, a list origin, the default quadrature
+    assert rs.rail.Track([0.0, 100.0], **tangent, gauge=1, origin=[1, 2, 3]) is not None
+    assert rs.FluidBody(mesh, water).n_coords > 0
+
+
+def test_a_compiled_function_names_a_negative_count_and_a_short_point():
+    # a negative count (PyO3's OverflowError) and a point of the wrong length (ValueError) carry
+    # PyO3's note like a wrong type does; the wrapper names the argument for them too
+    with pytest.raises(ValueError, match=r"^invalid `n_length` = -3: expected a non-negative integer"):
+        _core.elliptic_cylinder(12.0, 1.5, 1.5, 0.5, n_length=-3, n_width=2, n_height=2)
+    with pytest.raises(ValueError, match=r"^invalid `n_length`: expected a non-negative integer"):
+        _core.elliptic_cylinder(12.0, 1.5, 1.5, 0.5, -3, 2, 2)

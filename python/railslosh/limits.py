@@ -147,7 +147,7 @@ _NOTE = re.compile(r"while processing '([^']+)'")
 
 
 def _native_argument(error: TypeError) -> str | None:
-    """The argument that a compiled function's ``TypeError`` is about: PyO3 names it only in a
+    """The argument that a compiled function's extraction error is about: PyO3 names it only in a
     note (``while processing 't_end'``), which ``str(error)`` leaves out."""
     for note in getattr(error, "__notes__", ()):
         m = _NOTE.fullmatch(note)
@@ -161,12 +161,17 @@ def _named(fn: Callable[..., Any]) -> Callable[..., Any]:
     def call(*args: Any, **kwargs: Any) -> Any:
         try:
             return fn(*args, **kwargs)
-        except TypeError as e:
+        except (TypeError, ValueError, OverflowError) as e:
+            # PyO3 notes the argument on every extraction error: a wrong type (TypeError), a
+            # negative count (OverflowError) or a point of the wrong length (ValueError)
             field = _native_argument(e)
             if field is None:
                 raise
             shown = f" = {_show(kwargs[field])}" if field in kwargs else ""
-            raise TypeError(f"invalid `{field}`{shown}: {e}") from e
+            if isinstance(e, TypeError):
+                raise TypeError(f"invalid `{field}`{shown}: {e}") from e
+            why = f"expected a non-negative integer in range ({e})" if isinstance(e, OverflowError) else str(e)
+            raise ValueError(f"invalid `{field}`{shown}: {why}") from e
 
     return call
 

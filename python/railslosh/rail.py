@@ -109,10 +109,10 @@ class Track:
         self._inner = _core.Track(
             *cols,
             units=units,
-            gauge=float(gauge),
-            cant_base=float(cant_base),
-            origin=tuple(float(v) for v in origin),
-            heading=float(heading),
+            gauge=gauge,
+            cant_base=cant_base,
+            origin=origin,
+            heading=heading,
         )
 
     @classmethod

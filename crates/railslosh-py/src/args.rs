@@ -55,6 +55,48 @@ impl<'a, 'py> Args<'a, 'py> {
     }
 }
 
+/// An argument `name` of a class constructor, read with an error that names it: a wrong type
+/// is a `TypeError` ([`named_type_error`]); a value the type cannot hold (a negative count, a
+/// point of two coordinates) a `ValueError` in the same form. Functions get the name from
+/// `railslosh.limits.name_native_arguments`; classes cannot be wrapped that way, so their
+/// constructors read each argument through a reader of [`named_readers!`].
+pub(crate) fn named<'py, T>(name: &str, obj: &Bound<'py, PyAny>) -> PyResult<T>
+where
+    T: for<'b> FromPyObject<'b, 'py>,
+    for<'b> <T as FromPyObject<'b, 'py>>::Error: Into<PyErr>,
+{
+    obj.extract::<T>().map_err(|e| {
+        let e: PyErr = e.into();
+        let py = obj.py();
+        if e.is_instance_of::<pyo3::exceptions::PyTypeError>(py) {
+            named_type_error(name, obj, e)
+        } else {
+            let shown = obj.repr().map_or_else(|_| "?".to_string(), |r| r.to_string());
+            let why = if e.is_instance_of::<pyo3::exceptions::PyOverflowError>(py) {
+                format!("expected a non-negative integer in range ({})", e.value(py))
+            } else {
+                e.value(py).to_string()
+            };
+            pyo3::exceptions::PyValueError::new_err(format!("invalid `{name}` = {shown}: {why}"))
+        }
+    })
+}
+
+/// `from_py_with` readers, one per argument name, that name their argument in errors
+/// ([`named`]): `named_readers!(fluid_arg { density: f64, consistency: Option<f64> })` makes
+/// `fluid_arg::density` and `fluid_arg::consistency` (`None` reads as not given).
+macro_rules! named_readers {
+    ($module:ident { $($name:ident : $ty:ty),* $(,)? }) => {
+        mod $module {
+            use pyo3::prelude::*;
+            $(pub(super) fn $name(obj: &Bound<'_, PyAny>) -> PyResult<$ty> {
+                $crate::args::named(stringify!($name), obj)
+            })*
+        }
+    };
+}
+pub(crate) use named_readers;
+
 /// The `TypeError` of an argument `name` whose value `obj` has the wrong type (`error`, PyO3's),
 /// in the one form of input errors: ``invalid `t_end` = 'x': must be real number, not str``.
 /// PyO3 itself names the argument only in an exception note, which `str(error)` leaves out.

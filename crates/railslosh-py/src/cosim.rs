@@ -184,6 +184,11 @@ struct PySloshParticipant {
     inner: SloshParticipant,
 }
 
+crate::args::named_readers!(participant_arg {
+    tank_shape: String, tank_dims: Vec<f64>, bulkheads: Vec<(f64, f64)>, h_max: f64,
+    reference_point: [f64; 3], gravity: f64, t0: f64, viscous_points: usize, penalty_points: usize,
+});
+
 #[pymethods]
 impl PySloshParticipant {
     #[new]
@@ -194,17 +199,17 @@ impl PySloshParticipant {
         py: Python<'_>,
         mesh: &crate::PyFluidMesh,
         fluid: &crate::PyFluid,
-        tank_shape: &str,
-        tank_dims: Vec<f64>,
-        bulkheads: Vec<(f64, f64)>,
-        h_max: f64,
-        reference_point: [f64; 3],
-        gravity: f64,
-        t0: f64,
-        viscous_points: usize,
-        penalty_points: usize,
+        #[pyo3(from_py_with = participant_arg::tank_shape)] tank_shape: String,
+        #[pyo3(from_py_with = participant_arg::tank_dims)] tank_dims: Vec<f64>,
+        #[pyo3(from_py_with = participant_arg::bulkheads)] bulkheads: Vec<(f64, f64)>,
+        #[pyo3(from_py_with = participant_arg::h_max)] h_max: f64,
+        #[pyo3(from_py_with = participant_arg::reference_point)] reference_point: [f64; 3],
+        #[pyo3(from_py_with = participant_arg::gravity)] gravity: f64,
+        #[pyo3(from_py_with = participant_arg::t0)] t0: f64,
+        #[pyo3(from_py_with = participant_arg::viscous_points)] viscous_points: usize,
+        #[pyo3(from_py_with = participant_arg::penalty_points)] penalty_points: usize,
     ) -> PyResult<Self> {
-        let tank = tank_geometry(tank_shape, &tank_dims, &bulkheads)?;
+        let tank = tank_geometry(&tank_shape, &tank_dims, &bulkheads)?;
         let mut c = SloshParticipantConfig::new(mesh.inner.clone(), fluid.inner, tank);
         c.h_max = h_max;
         c.reference_point = reference_point;

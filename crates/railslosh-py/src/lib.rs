@@ -272,32 +272,11 @@ struct PyFluid {
     inner: Fluid,
 }
 
-/// A number argument of a class constructor, read with an error that names it
-/// ([`args::named_type_error`]; functions get the name from
-/// `railslosh.limits.name_native_arguments`, classes cannot be wrapped that way).
-fn named_number(name: &str, obj: &Bound<'_, PyAny>) -> PyResult<f64> {
-    obj.extract::<f64>().map_err(|e| args::named_type_error(name, obj, e))
-}
-
-/// `from_py_with` readers of the `Fluid` constructor's number arguments, one per name (the
-/// optional ones take `None` as not given).
-macro_rules! fluid_numbers {
-    ($($name:ident),*; $($optional:ident),*) => {
-        mod fluid_arg {
-            use super::*;
-            $(pub(super) fn $name(obj: &Bound<'_, PyAny>) -> PyResult<f64> {
-                named_number(stringify!($name), obj)
-            })*
-            $(pub(super) fn $optional(obj: &Bound<'_, PyAny>) -> PyResult<Option<f64>> {
-                if obj.is_none() { Ok(None) } else { named_number(stringify!($optional), obj).map(Some) }
-            })*
-        }
-    };
-}
-fluid_numbers!(
-    density, viscosity, yield_stress, power_index, bulk_penalty, bulk_damping, shear_rate_reg, shear_stabilization;
-    consistency, elastic_modulus
-);
+args::named_readers!(fluid_arg {
+    density: f64, viscosity: f64, yield_stress: f64, consistency: Option<f64>, power_index: f64,
+    elastic_modulus: Option<f64>, bulk_penalty: f64, bulk_damping: f64, shear_rate_reg: f64,
+    shear_stabilization: f64,
+});
 
 #[pymethods]
 impl PyFluid {
@@ -386,6 +365,8 @@ struct PyFluidBody {
     inner: FluidBody,
 }
 
+args::named_readers!(body_arg { viscous_points: usize, penalty_points: usize, mass_points: usize });
+
 #[pymethods]
 impl PyFluidBody {
     #[new]
@@ -394,9 +375,9 @@ impl PyFluidBody {
         py: Python<'_>,
         mesh: &PyFluidMesh,
         fluid: &PyFluid,
-        viscous_points: usize,
-        penalty_points: usize,
-        mass_points: usize,
+        #[pyo3(from_py_with = body_arg::viscous_points)] viscous_points: usize,
+        #[pyo3(from_py_with = body_arg::penalty_points)] penalty_points: usize,
+        #[pyo3(from_py_with = body_arg::mass_points)] mass_points: usize,
     ) -> PyResult<Self> {
         let q = QuadratureOptions { viscous: viscous_points, penalty: penalty_points, mass: mass_points };
         let (m, f) = (mesh.inner.clone(), fluid.inner);

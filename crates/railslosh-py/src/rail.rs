@@ -181,6 +181,8 @@ impl PyTrack {
     }
 }
 
+crate::args::named_readers!(track_arg { gauge: f64, cant_base: f64, origin: [f64; 3], heading: f64 });
+
 #[pymethods]
 impl PyTrack {
     /// Table columns (equal lengths) in SI units (`units="si"`: m, 1/m, m, fraction, rad,
@@ -199,10 +201,10 @@ impl PyTrack {
         cant_right: PyReadonlyArray1<'_, f64>,
         cant_left: PyReadonlyArray1<'_, f64>,
         units: &str,
-        gauge: f64,
-        cant_base: f64,
-        origin: [f64; 3],
-        heading: f64,
+        #[pyo3(from_py_with = track_arg::gauge)] gauge: f64,
+        #[pyo3(from_py_with = track_arg::cant_base)] cant_base: f64,
+        #[pyo3(from_py_with = track_arg::origin)] origin: [f64; 3],
+        #[pyo3(from_py_with = track_arg::heading)] heading: f64,
     ) -> PyResult<Self> {
         let us = match units {
             "si" => false,
