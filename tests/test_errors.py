@@ -1,5 +1,7 @@
 """Bad input gets a clear error naming the field; no Rust panic reaches Python."""
 
+import re
+
 import numpy as np
 import pytest
 
@@ -294,3 +296,36 @@ def test_a_compiled_function_names_a_negative_count_and_a_short_point():
         _core.elliptic_cylinder(12.0, 1.5, 1.5, 0.5, n_length=-3, n_width=2, n_height=2)
     with pytest.raises(ValueError, match=r"^invalid `n_length`: expected a non-negative integer"):
         _core.elliptic_cylinder(12.0, 1.5, 1.5, 0.5, -3, 2, 2)
+
+
+def _keys_the_binding_reads(call) -> set[str]:
+    """The keys a kernel's dict may hold, from the binding's message for an unknown key."""
+    with pytest.raises(ValueError, match=r"expected keys among \[") as info:
+        call()
+    listed = re.search(r"expected keys among \[(.*)\]", str(info.value)).group(1)
+    return set(re.findall(r'"([a-z_]+)"', listed))
+
+
+def test_the_kernel_argument_types_list_exactly_the_keys_the_binding_reads():
+    # issue 18: the typed dicts are defined once (railslosh.kernel_args, imported by the stub);
+    # a key the binding gains or drops without the type (or the other way round) fails here
+    from railslosh import kernel_args
+
+    def keys(cls) -> set[str]:
+        return set(cls.__required_keys__) | set(cls.__optional_keys__)
+
+    train = {"track": [[0.0] * 6, [3000.0] + [0.0] * 5], "station": 300.0, "speed": 0.0, "t_end": 0.01}
+    assert _keys_the_binding_reads(lambda: _core.run_train({**train, "_x": 0})) == keys(kernel_args.TrainArgs)
+    fluid_cargo = _keys_the_binding_reads(lambda: _core.run_fluid_train(train, {"fill": 0.5, "_x": 0}))
+    assert fluid_cargo == keys(kernel_args.FluidCargoArgs)
+    equivalent_cargo = _keys_the_binding_reads(lambda: _core.run_equivalent_train(train, {"fill": 0.5, "_x": 0}))
+    assert equivalent_cargo == keys(kernel_args.EquivalentCargoArgs)
+    m = rs.mesh.box((1.0, 0.4, 0.3), (1, 1, 1))
+    fluid = rs.fluids.newtonian(1000.0, 1e-3, depth=0.3)
+    scenario = {"tank_shape": "box", "tank_dims": [-0.5, -0.2, 0.0, 0.5, 0.2, 0.6], "t_end": 0.01, "step": 0.005}
+    assert _keys_the_binding_reads(lambda: _core.run_slosh(m, fluid, {**scenario, "_x": 0})) == keys(
+        kernel_args.SloshArgs
+    )
+    # the required keys are the ones the binding reports missing
+    assert kernel_args.TrainArgs.__required_keys__ == {"track", "station", "speed", "t_end"}
+    assert kernel_args.SloshArgs.__required_keys__ == {"tank_shape", "tank_dims", "t_end", "step"}

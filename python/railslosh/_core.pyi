@@ -2,10 +2,12 @@
 
 import os
 from collections.abc import Callable, Mapping, Sequence
-from typing import Any, TypedDict, final
+from typing import Any, final
 
 import numpy as np
 import numpy.typing as npt
+
+from railslosh.kernel_args import EquivalentCargoArgs, FluidCargoArgs, SloshArgs, TrainArgs
 
 __version__: str
 
@@ -154,35 +156,6 @@ def elliptic_cylinder(
     n_height: int,
 ) -> FluidMesh: ...
 def validation_cases() -> list[str]: ...
-
-class _SloshRequired(TypedDict):
-    tank_shape: str
-    tank_dims: list[float]
-    t_end: float
-    step: float
-
-class SloshArgs(_SloshRequired, total=False):
-    """The scenario of ``run_slosh`` (``railslosh.slosh.run`` builds it); a key left out or ``None``
-    takes ``rail_mbs::slosh::SloshScenario::new``'s default; an unknown key is a ValueError."""
-
-    bulkheads: list[tuple[float, float]]
-    acceleration: list[list[tuple[float, float]]]
-    rotation_axis: tuple[float, float, float] | None
-    angular_acceleration: list[tuple[float, float]]
-    frame: str
-    gravity: list[float]
-    viscous_points: int
-    penalty_points: int
-    volume_tolerance: float
-    penetration_limit: float
-    contact_stiffness_factor: float
-    contact_points_per_edge: int
-    contact_point_rule: str
-    stepper: str
-    wall_damping_ratio: float
-    snapshot_every: float
-    wall_adhesion: float
-
 def run_slosh(
     mesh: FluidMesh,
     fluid: Fluid,
@@ -349,59 +322,6 @@ def track_irregularity_defects(
 def track_psd(
     kind: str, channel_name: str, omega: npt.NDArray[np.float64], *, track_class: int | None = None
 ) -> npt.NDArray[np.float64]: ...
-
-class _TrainRequired(TypedDict):
-    track: list[list[float]]
-    station: float
-    speed: float
-    t_end: float
-
-class TrainArgs(_TrainRequired, total=False):
-    """The train of a vehicle run (``railslosh.vehicle._train_args`` builds it); a key left out or
-    ``None`` takes ``rail_mbs::vehicle::TrainScenario``'s default; an unknown key is a ValueError."""
-
-    irregularity: dict[str, Any] | None
-    cars: int
-    step: float
-    record_every: float
-    load_filter: str
-    snapshot_every: float
-    drive_speed: float | None
-    brake_times: list[float] | None
-    brake_torques: list[float] | None
-    brake_scope: str
-    brake_factors: list[float] | None
-    wheel_profile: str
-    wheelset_lateral_offset: float
-    coupler_stiffness: float | None
-    coupler_damping: float | None
-    car: dict[str, float | str] | None
-    friction_map: dict[str, Any] | None
-    lading_mass: float
-    lading_height: float
-
-class _FillRequired(TypedDict):
-    fill: float
-
-class FluidCargoArgs(_FillRequired, total=False):
-    """The ANCF cargo of ``run_fluid_train``; keys left out take ``FluidCargo::new``'s defaults."""
-
-    oil: str
-    fluid: Fluid | None
-    counts: tuple[int, int, int]
-    bulkheads: list[tuple[float, float]] | None
-    wall_damping_ratio: float
-    wall_adhesion: float
-    shear_stabilization: bool
-
-class EquivalentCargoArgs(_FillRequired, total=False):
-    """The equivalent-model cargo of ``run_equivalent_train``."""
-
-    oil: str
-    fluid: Fluid | None
-    bulkheads: list[tuple[float, float]] | None
-    slosh_axis: str
-
 def run_train(train: TrainArgs, *, progress: _Progress | None = None, stream: str | None = None) -> dict[str, Any]: ...
 def design_brake_torque(
     mass: float, v0: float = ..., v1: float = ..., duration: float = 10.0

@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 from railslosh import _core, limits
 from railslosh._core import Fluid, FluidMesh, RailsloshError
 from railslosh.constants import GRAVITY
+from railslosh.kernel_args import SloshArgs
 from railslosh.progress import ProgressArg
 from railslosh.progress import callback as progress_callback
 
@@ -241,7 +242,7 @@ def run(
         raise ValueError(f"invalid `motion.acceleration` axes {sorted(unknown)}: expected x, y, z")
     acc = [motion.acceleration.get(a, []) for a in ("x", "y", "z")]
     with progress_callback(progress, "slosh run") as on_progress:
-        scenario = dict(
+        scenario = SloshArgs(
             tank_shape=tank.shape,
             tank_dims=list(tank.dims),
             bulkheads=list(tank.bulkheads),

@@ -30,6 +30,7 @@ import numpy as np
 from railslosh import _core, limits
 from railslosh import irregularity as irregularity_module
 from railslosh.irregularity import CLEARANCE, Irregularity
+from railslosh.kernel_args import EquivalentCargoArgs, FluidCargoArgs, TrainArgs
 from railslosh.progress import ProgressArg
 from railslosh.progress import callback as progress_callback
 from railslosh.slosh import SimulationError
@@ -168,14 +169,14 @@ def _train_args(
     car: dict[str, float | str] | None,
     friction_map: Mapping[str, Any] | None,
     **settings: Any,
-) -> tuple[dict[str, Any], Irregularity | None]:
-    """The train of a vehicle run as the kernels take it (``railslosh._core.TrainArgs``), one form
+) -> tuple[TrainArgs, Irregularity | None]:
+    """The train of a vehicle run as the kernels take it (:class:`railslosh.kernel_args.TrainArgs`), one form
     for :func:`run`, :func:`run_fluid` and :func:`run_equivalent`, and the run's irregularity.
     ``settings`` are the remaining ``TrainArgs`` keys, passed on as given (``step``,
     ``record_every``, ``load_filter``, ``brake_scope``, ``wheel_profile``, ...)."""
     drive_speed, times, torques = _drive_and_brake(drive, speed, brake)
     samples, irr = _irregularity(irregularity, cars, station, car, _travel(speed, t_end))
-    train = dict(
+    train = TrainArgs(
         track=_table(track),
         irregularity=samples,
         cars=cars,
@@ -196,9 +197,9 @@ def _train_args(
 def _run_train(
     kernel: Any,
     what: str,
-    train: dict[str, Any],
+    train: TrainArgs,
     irr: Irregularity | None,
-    *cargo: dict[str, Any],
+    *cargo: FluidCargoArgs | EquivalentCargoArgs,
     progress: ProgressArg,
     stream: str | os.PathLike[str] | None,
     **extra: Any,
@@ -390,7 +391,7 @@ def run_fluid(
         brake_scope=brake_scope,
         wheel_profile=wheel_profile,
     )
-    cargo = dict(
+    cargo = FluidCargoArgs(
         oil=oil,
         fluid=fluid,
         counts=tuple(counts),
@@ -505,7 +506,7 @@ def run_equivalent(
         lading_height=lading_height,
         wheel_profile=wheel_profile,
     )
-    cargo = dict(
+    cargo = EquivalentCargoArgs(
         oil=oil,
         fluid=fluid,
         fill=fill,
