@@ -281,21 +281,6 @@ def run(
     return res
 
 
-_VECTORS = ("force_tank", "moment_tank", "force_global", "moment_global", "com_tank")
-_SCALARS = (
-    "volume",
-    "kinetic_energy",
-    "potential_energy",
-    "newton_iterations",
-    "max_penetration",
-    "stored_energy",
-    "input_work",
-    "energy_error",
-    "min_volume_ratio",
-    "containment_gap",
-)
-
-
 def read_stream(path: str | os.PathLike[str]) -> dict:
     """The samples of a :func:`run` ``stream`` file (also of an interrupted run: every complete
     sample), as the arrays of :func:`run` (``t``, ``force_tank`` (n, 3), ...), without ``stats``.
@@ -304,10 +289,14 @@ def read_stream(path: str | os.PathLike[str]) -> dict:
 
     from railslosh.journal import read_journal
 
+    # the columns are rail_mbs::slosh::SloshRecord::COLUMNS: a vector as its `_x`, `_y`, `_z`
     col = read_journal(path, "slosh stream")
-    out: dict = {"t": col["t"]}
-    for v in _VECTORS:
-        out[v] = np.stack([col[f"{v}_{a}"] for a in "xyz"], axis=1)
-    for k in _SCALARS:
-        out[k] = col[k].astype(np.int64) if k == "newton_iterations" else col[k]
+    out: dict = {}
+    for name, values in col.items():
+        stem, _, axis = name.rpartition("_")
+        if axis in ("x", "y", "z") and all(f"{stem}_{a}" in col for a in "xyz"):
+            if stem not in out:
+                out[stem] = np.stack([col[f"{stem}_{a}"] for a in "xyz"], axis=1)
+        else:
+            out[name] = values.astype(np.int64) if name == "newton_iterations" else values
     return out

@@ -301,13 +301,8 @@ impl InvariantMonitor {
         q: &[f64],
         energy: EnergySample,
     ) -> Result<Measured, SystemError> {
-        match self.assess(t, body, contact, kin, q, energy) {
-            Ok(p) => Ok(self.commit(p)),
-            Err((e, gap, j)) => {
-                self.note(t, gap, j);
-                Err(e)
-            }
-        }
+        let assessed = self.assess(t, body, contact, kin, q, energy);
+        self.account(t, assessed)
     }
 
     /// [`Self::check`] with the state already measured (see [`Self::assess_energy`]).
@@ -317,7 +312,13 @@ impl InvariantMonitor {
         measured: (f64, f64),
         energy: EnergySample,
     ) -> Result<Measured, SystemError> {
-        match self.assess_energy(t, measured, energy) {
+        let assessed = self.assess_energy(t, measured, energy);
+        self.account(t, assessed)
+    }
+
+    /// Commits an assessed state, or notes the violating one's margins and returns its error.
+    fn account(&mut self, t: f64, assessed: Result<Pending, (SystemError, f64, f64)>) -> Result<Measured, SystemError> {
+        match assessed {
             Ok(p) => Ok(self.commit(p)),
             Err((e, gap, j)) => {
                 self.note(t, gap, j);

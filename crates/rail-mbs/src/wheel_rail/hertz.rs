@@ -129,37 +129,13 @@ impl HertzConstants {
         } else {
             // curvature_ratio(g) rises monotonically from 0 to 1 on (0, 1]: Illinois
             // (modified regula falsi) on f(g) = ratio(g) − target, bracketed, to 1e-14 in g.
-            let f = |g: f64| curvature_ratio(g) - target;
-            let (mut lo, mut hi) = (1e-9f64, 1.0 - 1e-12);
-            let (mut flo, mut fhi) = (f(lo), f(hi));
-            let mut side = 0i8;
-            let mut g = 0.5 * (lo + hi);
-            for _ in 0..200 {
-                g = (lo * fhi - hi * flo) / (fhi - flo);
-                if !(g > lo && g < hi) {
-                    g = 0.5 * (lo + hi);
-                }
-                let fg = f(g);
-                if fg < 0.0 {
-                    lo = g;
-                    flo = fg;
-                    if side == -1 {
-                        fhi *= 0.5;
-                    }
-                    side = -1;
-                } else {
-                    hi = g;
-                    fhi = fg;
-                    if side == 1 {
-                        flo *= 0.5;
-                    }
-                    side = 1;
-                }
-                if hi - lo < 1e-14 || fg == 0.0 {
-                    break;
-                }
+            let f = |g: f64| Ok::<_, std::convert::Infallible>(curvature_ratio(g) - target);
+            let (lo, hi) = (1e-9f64, 1.0 - 1e-12);
+            let (flo, fhi) = (curvature_ratio(lo) - target, curvature_ratio(hi) - target);
+            match super::roots::illinois(f, (lo, flo), (hi, fhi), |lo, hi| hi - lo < 1e-14, 200) {
+                Ok(root) => root.x,
+                Err(never) => match never {},
             }
-            g
         };
         let m = 1.0 - g * g;
         let n = 1.0;

@@ -575,36 +575,9 @@ impl KpPatch {
                 )));
             }
         }
-        let mut side = 0i8;
-        for _ in 0..200 {
-            if hi - lo <= 1e-12 * hi {
-                break;
-            }
-            let mut d = (lo * fhi - hi * flo) / (fhi - flo);
-            if !(d > lo && d < hi) {
-                d = 0.5 * (lo + hi);
-            }
-            let fd = f(d)?;
-            if fd == 0.0 {
-                return Self::at_penetration(sep, d, epsilon, strips, e_star);
-            }
-            if fd < 0.0 {
-                lo = d;
-                flo = fd;
-                if side == -1 {
-                    fhi *= 0.5;
-                }
-                side = -1;
-            } else {
-                hi = d;
-                fhi = fd;
-                if side == 1 {
-                    flo *= 0.5;
-                }
-                side = 1;
-            }
-        }
-        Self::at_penetration(sep, 0.5 * (lo + hi), epsilon, strips, e_star)
+        let root = super::roots::illinois(f, (lo, flo), (hi, fhi), |lo, hi| hi - lo <= 1e-12 * hi, 200)?;
+        let d = if root.exact { root.x } else { 0.5 * (root.lo + root.hi) };
+        Self::at_penetration(sep, d, epsilon, strips, e_star)
     }
 
     /// Pressure at `(x, y)`, Pa (zero outside the patch; `y` resolved to its strip).
