@@ -28,6 +28,7 @@ pub mod error;
 pub mod mesh;
 pub mod quadrature;
 pub mod rng;
+pub mod roots;
 pub mod shape;
 pub mod simd;
 pub mod tank;

@@ -328,16 +328,7 @@ pub fn tank_liquid_volume(l: f64, r: f64, d: f64, h: f64) -> f64 {
 
 /// Depth that gives the liquid volume `target` (bisection on a monotone function).
 fn depth_for_volume(vol: impl Fn(f64) -> f64, hmax: f64, target: f64) -> f64 {
-    let (mut lo, mut hi) = (0.0, hmax);
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if vol(mid) < target {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    0.5 * (lo + hi)
+    crate::roots::bisect(0.0, hmax, 200, |h| vol(h) < target)
 }
 
 /// Coons (transfinite) map of the unit square onto the segment of the ellipse

@@ -68,12 +68,7 @@ impl LiquidSection {
         let (a, b) = (config.semi_axis_y, config.semi_axis_z);
         let target = config.fill * std::f64::consts::PI * a * b;
         let seg = |h: f64| (a / b) * circle_segment_area(b, h);
-        let (mut lo, mut hi) = (0.0, 2.0 * b);
-        for _ in 0..100 {
-            let mid = 0.5 * (lo + hi);
-            if seg(mid) < target { lo = mid } else { hi = mid }
-        }
-        let h = 0.5 * (lo + hi);
+        let h = ancf_core::roots::bisect(0.0, 2.0 * b, 100, |h| seg(h) < target);
         let zs = h - b;
         let area = seg(h);
         let width = 2.0 * a * (1.0 - (zs / b).powi(2)).max(0.0).sqrt();

@@ -151,16 +151,7 @@ impl Uic60Head {
     }
     /// Lateral position (mm) where the head reaches depth `d` below the crown.
     fn y_at_depth(&self, d: f64) -> f64 {
-        let (mut a, mut b) = (0.0, 60.0);
-        for _ in 0..80 {
-            let m = 0.5 * (a + b);
-            if self.z(m) > -d {
-                a = m;
-            } else {
-                b = m;
-            }
-        }
-        0.5 * (a + b)
+        ancf_core::roots::bisect(0.0, 60.0, 80, |y| self.z(y) > -d)
     }
 }
 
@@ -168,16 +159,9 @@ fn uic60_head() -> Uic60Head {
     // Solve for the R80/R13 tangent angle giving a 72 mm width at 14 mm depth.
     let a1 = (Y1 / R1).asin();
     let a3 = std::f64::consts::FRAC_PI_2 - (1.0f64 / 20.0).atan();
-    let (mut lo, mut hi) = (a1 + 1e-6, a3 - 1e-6);
-    for _ in 0..80 {
-        let m = 0.5 * (lo + hi);
-        if uic60_head_for(m).y_at_depth(WIDTH_DEPTH) < HALF_WIDTH {
-            lo = m;
-        } else {
-            hi = m;
-        }
-    }
-    uic60_head_for(0.5 * (lo + hi))
+    uic60_head_for(ancf_core::roots::bisect(a1 + 1e-6, a3 - 1e-6, 80, |a| {
+        uic60_head_for(a).y_at_depth(WIDTH_DEPTH) < HALF_WIDTH
+    }))
 }
 
 /// UIC 60 rail head height `z(y)` in metres (crate convention, uncanted, symmetric, crown

@@ -132,7 +132,7 @@ impl HertzConstants {
             let f = |g: f64| Ok::<_, std::convert::Infallible>(curvature_ratio(g) - target);
             let (lo, hi) = (1e-9f64, 1.0 - 1e-12);
             let (flo, fhi) = (curvature_ratio(lo) - target, curvature_ratio(hi) - target);
-            match super::roots::illinois(f, (lo, flo), (hi, fhi), |lo, hi| hi - lo < 1e-14, 200) {
+            match ancf_core::roots::illinois(f, (lo, flo), (hi, fhi), |lo, hi| hi - lo < 1e-14, 200) {
                 Ok(root) => root.x,
                 Err(never) => match never {},
             }

@@ -575,7 +575,7 @@ impl KpPatch {
                 )));
             }
         }
-        let root = super::roots::illinois(f, (lo, flo), (hi, fhi), |lo, hi| hi - lo <= 1e-12 * hi, 200)?;
+        let root = ancf_core::roots::illinois(f, (lo, flo), (hi, fhi), |lo, hi| hi - lo <= 1e-12 * hi, 200)?;
         let d = if root.exact { root.x } else { 0.5 * (root.lo + root.hi) };
         Self::at_penetration(sep, d, epsilon, strips, e_star)
     }

@@ -85,7 +85,6 @@ pub mod friction;
 pub mod hertz;
 pub mod kik_piotrowski;
 pub mod manchester;
-mod roots;
 pub mod static_load;
 
 pub use contact::{

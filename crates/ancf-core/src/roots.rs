@@ -1,17 +1,34 @@
-//! The bracketed root solve of the patch models: the Illinois variant of regula falsi, used by
-//! [`super::hertz::HertzConstants::new`] (the ellipse's axis ratio) and
-//! [`super::kik_piotrowski::KikPiotrowskiPatch::at_force`] (the penetration carrying a force).
+//! Bracketed roots of monotone scalar functions, one implementation each (issue 18):
+//! [`bisect`] (a fixed number of halvings: the liquid depth of a fill, the rail head's tangent
+//! angle) and [`illinois`], the Illinois variant of regula falsi (the Hertz ellipse's axis ratio,
+//! the Kik–Piotrowski penetration carrying a force).
 
 /// Where [`illinois`] stopped: the last point it evaluated and the final bracket.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Bracketed {
+pub struct Bracketed {
     /// The last point evaluated, with f(x) = 0 exactly when [`Self::exact`].
     pub x: f64,
     /// Whether f(x) was exactly 0.
     pub exact: bool,
-    /// The bracket [lo, hi] at the end (f(lo) < 0 ≤ f(hi)).
+    /// The lower end of the final bracket (f(lo) < 0).
     pub lo: f64,
+    /// The upper end of the final bracket (f(hi) ≥ 0).
     pub hi: f64,
+}
+
+/// `steps` halvings of [lo, hi] keeping the half where the boundary lies: `right_of(mid)` says
+/// whether it lies right of the midpoint (`lo = mid`) or not (`hi = mid`); returns the final
+/// midpoint. For a function rising through a target, `right_of = |x| f(x) < target`.
+pub fn bisect(mut lo: f64, mut hi: f64, steps: usize, mut right_of: impl FnMut(f64) -> bool) -> f64 {
+    for _ in 0..steps {
+        let mid = 0.5 * (lo + hi);
+        if right_of(mid) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
 }
 
 /// Illinois (modified regula falsi) on an increasing `f` bracketed by f(lo) = `flo` < 0 ≤
@@ -19,7 +36,7 @@ pub(crate) struct Bracketed {
 /// bracket) and halves the retained end's value when the same end is kept twice in a row. It
 /// stops before a step once `done(lo, hi)`, when f is exactly 0, or after `max_steps` steps;
 /// an error of `f` ends it with that error.
-pub(crate) fn illinois<E>(
+pub fn illinois<E>(
     mut f: impl FnMut(f64) -> Result<f64, E>,
     (mut lo, mut flo): (f64, f64),
     (mut hi, mut fhi): (f64, f64),
@@ -64,7 +81,17 @@ mod tests {
     use super::*;
 
     #[test]
-    fn it_finds_a_root_superlinearly_and_stops_where_told() {
+    fn bisection_halves_the_bracket_toward_the_boundary() {
+        // √2 on [0, 2] after 60 halvings (a bracket of 2^-59 m, below round-off)
+        let x = bisect(0.0, 2.0, 60, |x| x * x < 2.0);
+        assert!((x - 2f64.sqrt()).abs() <= 4.5e-16, "{x}");
+        // zero halvings: the midpoint; a boundary outside the bracket: its end
+        assert_eq!(bisect(0.0, 2.0, 0, |_| unreachable!()), 1.0);
+        assert!((bisect(0.0, 2.0, 60, |_| true) - 2.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn illinois_finds_a_root_superlinearly_and_stops_where_told() {
         // x³ − 2 on [0, 2]: the root 2^(1/3) to 1e-14 in fewer steps than bisection's 48
         let mut calls = 0;
         let f = |x: f64| -> Result<f64, ()> {
