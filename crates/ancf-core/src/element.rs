@@ -300,13 +300,31 @@ impl ElementRef {
     /// penalty and mass rules and the check points ([`ShapeTables::check`]), with the
     /// index of the point of the smallest (numbered viscous points first, then penalty,
     /// mass, then check points by their index in the check table). The mass and check
-    /// points differ from the force points, so a field folding between those is seen.
+    /// points differ from the force points, so a field folding between those is seen. A rule
+    /// of the same order as an earlier one has the same points and is skipped (its points keep
+    /// their numbers): a strictly smaller J cannot be there.
     pub fn volume_ratio_range(&self, e: &Compact, tables: &ShapeTables) -> (f64, usize, f64) {
+        self.volume_ratio_range_with(e, tables, true)
+    }
+
+    /// [`Self::volume_ratio_range`], skipping repeated rules or (`skip_repeated` false, the
+    /// reference its tests compare with) not.
+    #[doc(hidden)]
+    pub fn volume_ratio_range_with(&self, e: &Compact, tables: &ShapeTables, skip_repeated: bool) -> (f64, usize, f64) {
         let ehat = scaled(e, &self.scale);
         let mut out = (f64::INFINITY, 0, f64::NEG_INFINITY);
-        let rules = [(&self.viscous, &tables.viscous), (&self.penalty, &tables.penalty), (&self.mass, &tables.mass)];
+        let o = tables.options;
+        let rules = [
+            (&self.viscous, &tables.viscous, false),
+            (&self.penalty, &tables.penalty, skip_repeated && o.penalty == o.viscous),
+            (&self.mass, &tables.mass, skip_repeated && (o.mass == o.viscous || o.mass == o.penalty)),
+        ];
         let mut k = 0;
-        for (pts, table) in rules {
+        for (pts, table, seen) in rules {
+            if seen {
+                k += pts.len();
+                continue;
+            }
             for (rp, dn) in pts.iter().zip(&table.dn) {
                 let j = (grad_xi(&ehat, dn) * rp.jinv).determinant();
                 if j.is_nan() || j < out.0 {
