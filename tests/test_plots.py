@@ -168,3 +168,20 @@ def test_liquid_loads_recorded_at_every_step_are_also_drawn_through_the_20_hz_lo
     coarse = results.to_dataset({"t": t[::20], "force_tank": f[::20]})
     lateral = [a for a in plots.figure(coarse, "slosh_force").axes if a.get_ylabel().startswith("Lateral")][0]
     assert [ln.get_label() for ln in lateral.get_lines()] == ["Liquid force on the tank"]
+
+
+@pytest.mark.parametrize(
+    ("run_title", "one_line"),
+    [("ECP braking, light crude", True), ("Light crude at 60 km/h on FRA class 5 track, three-piece trucks", False)],
+)
+def test_a_long_run_title_goes_on_its_own_line_and_stays_inside_the_figure(run_title, one_line, tmp_path):
+    # the FRA class 5 three-piece scene's title ran off both sides of its PNGs on one line
+    ds = _slosh()
+    ds.attrs["title"] = run_title
+    fig = plots.figure(ds, "slosh_force")
+    title = fig._suptitle.get_text()
+    assert title.endswith(run_title)
+    assert ("\n" not in title) == one_line
+    fig.savefig(tmp_path / "f.png")  # lays the figure out
+    box = fig._suptitle.get_window_extent()
+    assert box.x0 >= 0 and box.x1 <= fig.bbox.width, (box, fig.bbox)

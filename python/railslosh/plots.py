@@ -356,10 +356,28 @@ def _draw(fig: Any, ds: Any, spec: tuple[str, str, tuple[str, ...], str]) -> Non
             ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0))
     axes[-1].set_xlabel("Time (s)")
     frame = ds[names[0]].attrs.get("frame", "") if names[0] in ds.data_vars else ""
-    run = ds.attrs.get("title", "")
-    fig.suptitle(f"{title}{f' — {run}' if run else ''}")
+    _suptitle(fig, title, ds.attrs.get("title", ""))
     if frame:
         fig.text(0.995, 0.005, f"frame: {frame} (docs/frames.md)", ha="right", va="bottom", fontsize=7, color="0.4")
+
+
+def _suptitle(fig: Any, title: str, run: str) -> None:
+    """The figure's title: the plot's ``title``, then the run's title after a dash on the same
+    line when that fits the figure's width, else on a line of its own (a long scene title would
+    otherwise run off both sides of the saved PNG)."""
+    import matplotlib as mpl
+    from matplotlib.font_manager import FontProperties
+    from matplotlib.textpath import TextToPath
+
+    if not run:
+        fig.suptitle(title)
+        return
+    last = title.split("\n")[-1]
+    one_line = f"{last} — {run}"
+    prop = FontProperties(size=mpl.rcParams["figure.titlesize"], weight=mpl.rcParams["figure.titleweight"])
+    width_pt, _, _ = TextToPath().get_text_width_height_descent(one_line, prop, ismath=False)
+    fits = width_pt <= 0.92 * fig.get_figwidth() * 72.0
+    fig.suptitle(f"{title} — {run}" if fits else f"{title}\n{run}")
 
 
 def _irregularity(ds: Any) -> tuple[Any, dict[str, Any]] | None:
@@ -471,8 +489,7 @@ def _draw_irregularity(fig: Any, irr: Any, spec: dict[str, Any], ds: Any, plot: 
                 axes[-1].set_xlim(min(irr.start, span[0]) - 5.0, right)
                 xlabel += f"; the part run over (the irregularity goes on to {irr.end:.6g} m)"
         axes[-1].set_xlabel(xlabel)
-    run = ds.attrs.get("title", "")
-    fig.suptitle(f"{title}\n{_irregularity_title(spec)}{f' — {run}' if run else ''}")
+    _suptitle(fig, f"{title}\n{_irregularity_title(spec)}", ds.attrs.get("title", ""))
     fig.text(0.995, 0.005, "frame: track (docs/frames.md)", ha="right", va="bottom", fontsize=7, color="0.4")
 
 
