@@ -188,7 +188,13 @@ def _cmd_run(args: argparse.Namespace) -> int:
     status = 0
     t0 = time.perf_counter()
     try:
-        res = scene.run_scene(sc, progress=bar)
+        res = scene.run_scene(
+            sc,
+            progress=bar,
+            checkpoint=args.checkpoint,
+            checkpoint_every=args.checkpoint_every,
+            resume_from=args.resume_from,
+        )
     except SimulationError as exc:
         if bar is not None:
             bar.close()
@@ -199,7 +205,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
     except KeyboardInterrupt:
         if bar is not None:
             bar.close()
-        print("\nrailslosh run: interrupted", file=sys.stderr)
+        again = f"; continue it with --resume-from {args.checkpoint}" if args.checkpoint else ""
+        print(f"\nrailslosh run: interrupted{again}", file=sys.stderr)
         return 130
     wall = time.perf_counter() - t0
     ds = results.to_dataset(res, sc)
@@ -223,6 +230,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
         "error": res.get("error"),
         "margins": res.get("margins"),
     }
+    if args.resume_from:  # a continued run: its results start at the checkpoint
+        summary["resumed_from"] = {"file": str(args.resume_from), "t": float(res["t"][0]) if len(res["t"]) else None}
     # the model and largest step the run used (run_scene records them, also on a failed run)
     keys = ("fluid_model", "fluid_model_reason", "step", "step_reason", "stepper", "stepper_reason")
     summary |= {k: res[k] for k in keys if k in res}
@@ -417,13 +426,30 @@ def _add_run(sub: Any) -> None:
         "several minutes (the paper's 10.5 s ECP braking with ANCF oil); --t-end shortens a run.",
         "  railslosh run examples/scenes/two_car_ecp_braking_rigid.toml\n"
         "  railslosh run examples/scenes/crude_ecp_braking_light.toml -o out/ecp --t-end 1\n"
-        "  railslosh run examples/scenes/crude_curve_60kmh.toml --set fluid.oil=heavy --set fluid.fill=0.7",
+        "  railslosh run examples/scenes/crude_curve_60kmh.toml --set fluid.oil=heavy --set fluid.fill=0.7\n"
+        "  railslosh run examples/scenes/crude_ecp_braking_light.toml --checkpoint out/ecp.ckpt   (Ctrl-C, then)\n"
+        "  railslosh run examples/scenes/crude_ecp_braking_light.toml --resume-from out/ecp.ckpt -o out/ecp_rest",
     )
     r.add_argument("scene", help="scene file, e.g. examples/scenes/crude_ecp_braking_light.toml")
     r.add_argument("-o", "--out", help="output directory (default: out/<scene name>)")
     r.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE", help=_SET_HELP)
     r.add_argument("--t-end", type=_positive_float, help="override the simulated time, s (train.t_end or solver.t_end)")
     r.add_argument("-q", "--quiet", action="store_true", help="no progress line")
+    r.add_argument(
+        "--checkpoint", metavar="FILE", help="keep the run's whole state in FILE as it goes (replaced atomically)"
+    )
+    r.add_argument(
+        "--checkpoint-every",
+        type=_positive_int,
+        default=50,
+        metavar="N",
+        help="recorded samples between two checkpoints (default 50)",
+    )
+    r.add_argument(
+        "--resume-from",
+        metavar="FILE",
+        help="continue the same scene from a checkpoint; the results start there, bit for bit the uninterrupted run's",
+    )
     r.set_defaults(func=_cmd_run)
 
 

@@ -50,6 +50,9 @@ class TrainArgs(_TrainRequired, total=False):
     friction_map: dict[str, Any] | None
     lading_mass: float
     lading_height: float
+    checkpoint: str | None
+    checkpoint_every: int | None
+    resume_from: str | None
 
 
 class _FillRequired(TypedDict):

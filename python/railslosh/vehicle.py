@@ -194,6 +194,17 @@ def _train_args(
     return train, irr
 
 
+def _run_files(
+    checkpoint: str | os.PathLike[str] | None, checkpoint_every: int, resume_from: str | os.PathLike[str] | None
+) -> dict[str, Any]:
+    """The ``TrainArgs`` keys of a run's checkpoint file and the file it resumes from."""
+    return {
+        "checkpoint": None if checkpoint is None else os.fspath(checkpoint),
+        "checkpoint_every": checkpoint_every,
+        "resume_from": None if resume_from is None else os.fspath(resume_from),
+    }
+
+
 def _run_train(
     kernel: Any,
     what: str,
@@ -240,6 +251,9 @@ def run(
     car: dict[str, float | str] | None = None,
     progress: ProgressArg = None,
     stream: str | os.PathLike[str] | None = None,
+    checkpoint: str | os.PathLike[str] | None = None,
+    checkpoint_every: int = 50,
+    resume_from: str | os.PathLike[str] | None = None,
     friction_map: Mapping[str, Any] | None = None,
 ) -> dict[str, Any]:
     """Run ``cars`` coupled tank cars on ``track`` and return arrays of wheel loads ``Q``
@@ -254,6 +268,11 @@ def run(
     then about every 0.5 s of wall time and at the end; if it raises, the run stops and the
     exception propagates. ``stream`` (a file path) writes every recorded sample to that file as it
     is computed (flushed per sample), so an interrupted run keeps it; read it with :func:`read_stream`.
+    ``checkpoint`` (a file path) keeps the whole run's state there, replaced atomically every
+    ``checkpoint_every`` recorded samples; ``resume_from`` continues a run of the same arguments from
+    such a file: the results start at the checkpoint's sample and are bit for bit those of the
+    uninterrupted run from there on (``rail_mbs::vehicle::checkpoint``). The same in
+    :func:`run_fluid` and :func:`run_equivalent`.
 
     Load channels (``Q``, ``Y``, coupler and fluid forces) are recorded every ``record_every`` s as
     ``load_filter = "hat_mean"`` (default): their mean over the integrator steps weighted by the
@@ -303,6 +322,7 @@ def run(
         wheelset_lateral_offset=wheelset_lateral_offset,
         coupler_stiffness=coupler_stiffness,
         coupler_damping=coupler_damping,
+        **_run_files(checkpoint, checkpoint_every, resume_from),
     )
     return _run_train(_core.run_train, "vehicle run", train, irr, progress=progress, stream=stream)
 
@@ -341,6 +361,9 @@ def run_fluid(
     car: dict[str, float | str] | None = None,
     progress: ProgressArg = None,
     stream: str | os.PathLike[str] | None = None,
+    checkpoint: str | os.PathLike[str] | None = None,
+    checkpoint_every: int = 50,
+    resume_from: str | os.PathLike[str] | None = None,
     friction_map: Mapping[str, Any] | None = None,
     wall_damping_ratio: float = WALL_DAMPING_RATIO,
     wall_adhesion: float = 0.0,
@@ -390,6 +413,7 @@ def run_fluid(
         snapshot_every=snapshot_every,
         brake_scope=brake_scope,
         wheel_profile=wheel_profile,
+        **_run_files(checkpoint, checkpoint_every, resume_from),
     )
     cargo = FluidCargoArgs(
         oil=oil,
@@ -472,6 +496,9 @@ def run_equivalent(
     car: dict[str, float | str] | None = None,
     progress: ProgressArg = None,
     stream: str | os.PathLike[str] | None = None,
+    checkpoint: str | os.PathLike[str] | None = None,
+    checkpoint_every: int = 50,
+    resume_from: str | os.PathLike[str] | None = None,
     friction_map: Mapping[str, Any] | None = None,
 ) -> dict[str, Any]:
     """Run tank cars whose liquid is its equivalent mechanical model: per compartment one slosh mass
@@ -505,6 +532,7 @@ def run_equivalent(
         lading_mass=lading_mass,
         lading_height=lading_height,
         wheel_profile=wheel_profile,
+        **_run_files(checkpoint, checkpoint_every, resume_from),
     )
     cargo = EquivalentCargoArgs(
         oil=oil,

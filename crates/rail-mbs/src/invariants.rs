@@ -260,6 +260,62 @@ impl InvariantMonitor {
         }
     }
 
+    /// Appends the monitor's account (energy reference, work so far, worst margins, the last
+    /// state's measures) to `out`, as [`Self::restore_account`] reads it back: a resumed run
+    /// goes on with the same energy balance and margins.
+    pub fn save_account(&self, out: &mut Vec<f64>) {
+        let opt = |x: Option<f64>| [x.map_or(0.0, |_| 1.0), x.unwrap_or(0.0)];
+        out.extend(opt(self.e0));
+        out.extend(opt(self.last.map(|l| l.0)));
+        out.push(self.last.map_or(0.0, |l| l.1));
+        out.extend([self.input_work, self.abs_work, self.max_kinetic]);
+        let m = &self.margins;
+        out.extend([
+            m.worst_gap,
+            m.worst_gap_time,
+            m.gap_limit,
+            m.worst_energy_error,
+            m.worst_energy_time,
+            m.min_volume_ratio,
+            m.min_volume_ratio_time,
+            m.dissipated,
+        ]);
+        let l = self.last_measured;
+        out.push(l.map_or(0.0, |_| 1.0));
+        let l = l.unwrap_or(Measured { gap: 0.0, min_volume_ratio: 0.0, energy_error: 0.0, input_work: 0.0 });
+        out.extend([l.gap, l.min_volume_ratio, l.energy_error, l.input_work]);
+    }
+
+    /// Reads an account written by [`Self::save_account`] from the front of `data`, advancing
+    /// it; `None` when `data` is too short.
+    pub fn restore_account(&mut self, data: &mut &[f64]) -> Option<()> {
+        const LEN: usize = 2 + 3 + 3 + 8 + 1 + 4;
+        let d = data.get(..LEN)?;
+        let opt = |flag: f64, x: f64| (flag == 1.0).then_some(x);
+        self.e0 = opt(d[0], d[1]);
+        self.last = opt(d[2], d[3]).map(|t| (t, d[4]));
+        [self.input_work, self.abs_work, self.max_kinetic] = [d[5], d[6], d[7]];
+        let m = &mut self.margins;
+        [
+            m.worst_gap,
+            m.worst_gap_time,
+            m.gap_limit,
+            m.worst_energy_error,
+            m.worst_energy_time,
+            m.min_volume_ratio,
+            m.min_volume_ratio_time,
+            m.dissipated,
+        ] = [d[8], d[9], d[10], d[11], d[12], d[13], d[14], d[15]];
+        self.last_measured = (d[16] == 1.0).then_some(Measured {
+            gap: d[17],
+            min_volume_ratio: d[18],
+            energy_error: d[19],
+            input_work: d[20],
+        });
+        *data = &data[LEN..];
+        Some(())
+    }
+
     /// What the last accounted state measured (None before the first).
     pub fn last_measured(&self) -> Option<Measured> {
         self.last_measured

@@ -316,6 +316,15 @@ fn train_scenario(d: &Bound<'_, PyDict>) -> PyResult<TrainScenario> {
     sc.brake_factors = a.opt("brake_factors")?.unwrap_or_default();
     sc.wheelset_lateral_offset = a.opt("wheelset_lateral_offset")?.unwrap_or(sc.wheelset_lateral_offset);
     sc.coupler = (a.opt("coupler_stiffness")?, a.opt("coupler_damping")?);
+    let every: Option<usize> = a.opt("checkpoint_every")?;
+    if let Some(path) = a.opt::<std::path::PathBuf>("checkpoint")? {
+        let every = every.unwrap_or(50);
+        if every == 0 {
+            return Err(crate::to_py(invalid("checkpoint_every", every, "an integer >= 1 (recorded samples)")));
+        }
+        sc.checkpoints = Some(rail_mbs::vehicle::RunCheckpoints { path, every });
+    }
+    sc.resume_from = a.opt("resume_from")?;
     a.finish()?;
     Ok(sc)
 }

@@ -170,7 +170,8 @@ impl CheckpointFile {
         self.write_bytes(&checkpoint.to_bytes())
     }
 
-    fn write_bytes(&mut self, bytes: &[u8]) -> Result<(), IntegratorError> {
+    /// Writes `bytes` now, atomically (a run checkpoint of another format than [`Checkpoint`]).
+    pub fn write_bytes(&mut self, bytes: &[u8]) -> Result<(), IntegratorError> {
         let tmp = self.path.with_extension("tmp");
         let result = (|| {
             let mut f = File::create(&tmp)?;

@@ -142,6 +142,7 @@ mod system;
 
 pub use error::{FailureCause, IntegratorError, KktIndex, Quantity, SystemError};
 pub use explicit::{BlockMass, Explicit, ExplicitCheckpoint, ExplicitParams, StableStep};
+pub(crate) use hht::checkpoint::{Reader as BytesReader, Writer as BytesWriter, bad as bad_checkpoint};
 pub use hht::{Checkpoint, Hht, StateRef, StepInfo};
 pub use iterative::{IterativeParams, LinearSolverKind};
 pub use journal::{CheckpointFile, Journal, read_journal};

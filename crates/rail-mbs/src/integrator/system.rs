@@ -199,6 +199,21 @@ pub trait MechanicalSystem {
         index.to_string()
     }
 
+    /// Appends what the system carries from step to step beyond `(q, v)` and changes as it
+    /// runs (warm starts of a contact search, the run-time invariants' energy account) to
+    /// `out`, for a checkpoint of a whole run; [`Self::restore_internal_state`] reads it back
+    /// into a freshly built system so that the run continues bit for bit. Default: nothing.
+    fn save_internal_state(&self, out: &mut Vec<f64>) {
+        let _ = out;
+    }
+
+    /// Reads the state [`Self::save_internal_state`] wrote from the front of `data`, advancing
+    /// it; `None` when it does not fit this system. Default: reads nothing.
+    fn restore_internal_state(&mut self, data: &mut &[f64]) -> Option<()> {
+        let _ = data;
+        Some(())
+    }
+
     /// Optional acceptance check of a converged step at `(t, q, v)`, before it is
     /// committed (e.g. contact penetration beyond a limit, see
     /// [`SystemError::Penetration`]). An error rejects the step: in adaptive mode it is

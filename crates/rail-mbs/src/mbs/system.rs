@@ -423,6 +423,24 @@ impl MechanicalSystem for Multibody {
         7 * self.bodies.len()
     }
 
+    /// The wheel/rail searches' warm starts, wheelset by wheelset, left then right.
+    fn save_internal_state(&self, out: &mut Vec<f64>) {
+        for w in &self.wheelsets {
+            for c in &w.wheels {
+                c.save_warm_start(out);
+            }
+        }
+    }
+
+    fn restore_internal_state(&mut self, data: &mut &[f64]) -> Option<()> {
+        for w in &mut self.wheelsets {
+            for c in &mut w.wheels {
+                c.restore_warm_start(data)?;
+            }
+        }
+        Some(())
+    }
+
     fn n_constraints(&self) -> usize {
         self.bodies.len() + self.joints.iter().map(|j| j.n_equations()).sum::<usize>()
     }

@@ -33,12 +33,15 @@
 //! rate `V κ`, and — wheelsets — the rolling spin `V / r₀`. The front of the car (bogie
 //! 1, coupler end A) points towards increasing `s`.
 
+pub mod checkpoint;
 pub mod equivalent;
 pub mod fluid;
+mod load_filter;
 mod record;
 mod run;
 mod tank_car;
 
+pub use checkpoint::{RunCheckpoints, VehicleCheckpoint};
 pub use equivalent::{
     EquivalentCargo, EquivalentModel, EquivalentTrainFailure, EquivalentTrainRecord, SloshAxis, build_equivalent_train,
     run_equivalent_train,

@@ -12,7 +12,9 @@ use super::tank_car::{CarBodies, wheel_loads};
 use crate::integrator::{Hht, IntegratorError};
 use crate::mbs::Multibody;
 use crate::track::Track;
-use ancf_core::error::{AncfError, invalid};
+
+pub(crate) use super::load_filter::HatMean;
+pub use super::load_filter::{LoadFilter, hat_mean_resample};
 
 /// Recorded results of a train run. Arrays are indexed `[sample][...]`.
 #[derive(Debug, Clone, Default)]
@@ -239,149 +241,18 @@ pub(crate) fn record_sample(
     Ok(())
 }
 
-/// How the load channels of a vehicle record (wheel loads `Q` and `Y`, coupler forces and,
-/// in fluid runs, the fluid force on each tank) are sampled at the recording times.
-///
-/// The integrator steps several times per recording interval; loads carry content (wheel/rail
-/// and wall-contact ringing, 20-30 Hz in the ECP study) above the Nyquist frequency of the
-/// record, which point samples alias into spurious low-frequency noise (issue 16 §3).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum LoadFilter {
-    /// The value at the recording time (aliases content above 1/(2 `record_every`)).
-    Sample,
-    /// Default. The mean over the accepted steps weighted by the hat function of the sample,
-    /// w_k(t) = 1 − |t − t_k|/Δ on [t_{k−1}, t_{k+1}] (integrated exactly for loads linear
-    /// over each step): a zero-phase triangular low-pass of frequency response
-    /// sinc²(fΔ) for Δ = `record_every`: −3 dB at 0.32/Δ (16 Hz at Δ = 0.02 s), −7.8 dB at
-    /// the Nyquist frequency 0.5/Δ, zeros at multiples of 1/Δ, side lobes below −26 dB.
-    /// The hats form a partition of unity, so means and impulses (∫F dt) are preserved.
-    /// Kinematic channels (positions, speeds, centre of mass) stay point samples.
-    #[default]
-    HatMean,
-}
-
-impl LoadFilter {
-    /// Name used in results metadata (`"hat_mean"` or `"sample"`).
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Sample => "sample",
-            Self::HatMean => "hat_mean",
-        }
-    }
-
-    /// Parses [`LoadFilter::name`].
-    pub fn parse(name: &str) -> Result<Self, AncfError> {
-        match name {
-            "sample" => Ok(Self::Sample),
-            "hat_mean" => Ok(Self::HatMean),
-            other => Err(invalid("load_filter", other, "\"hat_mean\" or \"sample\"")),
-        }
-    }
-}
-
 /// What [`step_and_record`] asks of a run's recorder.
 pub(crate) enum RecordEvent<'a> {
     /// Record point sample `k` at the integrator's state (all channels).
     Sample(usize),
+    /// Sample `k` is recorded and the load filter has moved past it: a run checkpoint may be
+    /// taken here (the filter's state is what a resumed run starts from).
+    Recorded(usize, &'a HatMean),
     /// Write the load channels at the integrator's state into the vector (cleared first).
     Loads(&'a mut Vec<f64>),
     /// Sample `k` is final: replace its load channels by these (when filtered), then emit it
     /// to the results stream.
     Finish(usize, Option<&'a [f64]>),
-}
-
-/// Accumulates the hat-weighted means of [`LoadFilter::HatMean`] over the accepted steps:
-/// every step lies between two recording times t_{k−1} ≤ t_a < t_b ≤ t_k, where only the
-/// hats of samples k − 1 (falling) and k (rising) are non-zero.
-#[derive(Debug, Default)]
-pub(crate) struct HatMean {
-    /// (t, loads) at the end of the last accepted step.
-    last: Option<(f64, Vec<f64>)>,
-    /// ∫ f w dt and ∫ w dt of samples k − 1 and k.
-    num: [Vec<f64>; 2],
-    den: [f64; 2],
-}
-
-impl HatMean {
-    /// Starts at the first recording time with the loads there.
-    fn start(&mut self, t: f64, f: Vec<f64>) {
-        self.num = [vec![0.0; f.len()], vec![0.0; f.len()]];
-        self.den = [0.0; 2];
-        self.last = Some((t, f));
-    }
-
-    /// Adds the step from the last state to `(t, f)`, inside [t0, t1] = [t_{k−1}, t_k].
-    fn step(&mut self, t0: f64, t1: f64, t: f64, f: Vec<f64>) {
-        let Some((ta, fa)) = self.last.take() else { return };
-        let width = t1 - t0;
-        if width > 0.0 && t > ta {
-            // weights of sample k (rising) at both ends; sample k − 1 has 1 − w
-            let (wa, wb) = (((ta - t0) / width).clamp(0.0, 1.0), ((t - t0) / width).clamp(0.0, 1.0));
-            let h6 = (t - ta) / 6.0;
-            for (j, (ua, ub)) in [(1.0 - wa, 1.0 - wb), (wa, wb)].into_iter().enumerate() {
-                // exact ∫ f w for f, w linear over the step
-                for ((n, &x), &y) in self.num[j].iter_mut().zip(&fa).zip(&f) {
-                    *n += h6 * (2.0 * x * ua + x * ub + y * ua + 2.0 * y * ub);
-                }
-                self.den[j] += h6 * 3.0 * (ua + ub);
-            }
-        }
-        self.last = Some((t, f));
-    }
-
-    /// The mean of slot `j` (0: sample k − 1, 1: sample k), `None` before any step.
-    fn mean(&self, j: usize) -> Option<Vec<f64>> {
-        (self.den[j] > 0.0).then(|| self.num[j].iter().map(|n| n / self.den[j]).collect())
-    }
-
-    /// Moves on to the next interval: sample k becomes k − 1.
-    fn shift(&mut self) {
-        self.num.swap(0, 1);
-        self.num[1].iter_mut().for_each(|x| *x = 0.0);
-        self.den = [self.den[1], 0.0];
-    }
-}
-
-/// Resamples a series recorded at arbitrary increasing times `t` (channels `f[i]` at `t[i]`,
-/// linear in between) onto the grid 0, Δ, 2Δ, … (up to the last time) by the hat-weighted mean
-/// of [`LoadFilter::HatMean`], the filter vehicle runs record their loads with: the sweep puts
-/// the adaptive steps of slosh runs on a common grid this way. Grid times are inserted into the
-/// series by linear interpolation, so the integral is exact for the piecewise-linear series.
-pub fn hat_mean_resample(t: &[f64], f: &[Vec<f64>], dt: f64) -> Result<Vec<Vec<f64>>, AncfError> {
-    if t.len() != f.len() || t.is_empty() {
-        return Err(invalid("t", t.len(), &format!("as many times as samples ({}), at least one", f.len())));
-    }
-    if !(dt.is_finite() && dt > 0.0) {
-        return Err(invalid("dt", dt, "a finite interval > 0"));
-    }
-    if let Some(i) = t.windows(2).position(|w| w[1] <= w[0] || w[1].is_nan()) {
-        return Err(invalid(&format!("t[{}]", i + 1), t[i + 1], "increasing times"));
-    }
-    let n_rec = ((t[t.len() - 1] - t[0]) / dt + 1e-9).floor() as usize;
-    let at = |x: f64, i: usize| -> Vec<f64> {
-        // linear interpolation on [t[i], t[i + 1]]
-        let w = (x - t[i]) / (t[i + 1] - t[i]);
-        f[i].iter().zip(&f[i + 1]).map(|(a, b)| a + w * (b - a)).collect()
-    };
-    let mut hat = HatMean::default();
-    hat.start(t[0], f[0].clone());
-    let mut out: Vec<Vec<f64>> = Vec::with_capacity(n_rec + 1);
-    let mut i = 0;
-    for k in 1..=n_rec + 1 {
-        let (t0, t1) = (t[0] + (k - 1) as f64 * dt, t[0] + k as f64 * dt);
-        // the samples inside (t0, t1], then the grid time t1 itself (interpolated)
-        while i + 1 < t.len() && t[i + 1] < t1 {
-            i += 1;
-            hat.step(t0, t1, t[i], f[i].clone());
-        }
-        if i + 1 < t.len() {
-            hat.step(t0, t1, t1, at(t1, i));
-        }
-        // sample k − 1 is final: its window [t_{k−2}, t_k] is integrated
-        out.push(hat.mean(0).unwrap_or_else(|| f[0].clone()));
-        hat.shift();
-    }
-    Ok(out)
 }
 
 /// Steps `hht` to every recording time of `sc` (0, `record_every`, … `t_end`), asking
@@ -390,20 +261,28 @@ pub fn hat_mean_resample(t: &[f64], f: &[Vec<f64>], dt: f64) -> Result<Vec<Vec<f
 /// replaced by their hat-weighted mean and emitted) once the next recording time is reached,
 /// or when the run stops, with the part of its window integrated so far. Calls `observe`
 /// after every step; stops at the first error or when `observe` returns `false`.
+///
+/// `resume`: the sample a run checkpoint was taken after and the load filter then: the run
+/// records that sample again at the integrator's (restored) state and goes on from there.
 pub(crate) fn step_and_record<S: crate::integrator::MechanicalSystem>(
     hht: &mut Hht<S>,
     sc: &TrainScenario,
     observe: Observer<'_>,
+    resume: Option<(usize, HatMean)>,
     mut record: impl FnMut(&mut Hht<S>, RecordEvent<'_>) -> Result<(), IntegratorError>,
 ) -> Result<(), IntegratorError> {
     let n_rec = (sc.t_end / sc.record_every).round() as usize;
     let filtered = sc.load_filter == LoadFilter::HatMean;
+    let (k0, mut restored) = match resume {
+        Some((k, hat)) => (k, Some(hat)),
+        None => (0, None),
+    };
     let mut hat = HatMean::default();
     let mut buf = Vec::new();
     // the last sample recorded and not yet finished
     let mut pending: Option<usize> = None;
     let mut result = Ok(());
-    'samples: for k in 0..=n_rec {
+    'samples: for k in k0..=n_rec {
         let t_prev = if k == 0 { 0.0 } else { ((k - 1) as f64 * sc.record_every).min(sc.t_end) };
         let target = (k as f64 * sc.record_every).min(sc.t_end);
         while hht.t() < target - 1e-12 {
@@ -431,7 +310,10 @@ pub(crate) fn step_and_record<S: crate::integrator::MechanicalSystem>(
         if let Some(j) = pending.take() {
             record(hht, RecordEvent::Finish(j, hat.mean(0).as_deref()))?;
         }
-        if filtered {
+        if let Some(h) = restored.take() {
+            // resumed: the filter as it was after this sample
+            hat = h;
+        } else if filtered {
             if k == 0 {
                 if let Err(e) = record(hht, RecordEvent::Loads(&mut buf)) {
                     result = Err(e);
@@ -443,6 +325,10 @@ pub(crate) fn step_and_record<S: crate::integrator::MechanicalSystem>(
             }
         }
         pending = Some(k);
+        if let Err(e) = record(hht, RecordEvent::Recorded(k, &hat)) {
+            result = Err(e);
+            break;
+        }
     }
     // the last sample: its window ends at t_end, or where the run stopped (then with the
     // part integrated so far)
@@ -507,7 +393,7 @@ mod tests {
         let w = 2.0 * std::f64::consts::PI * freq;
         let mut hht = Hht::new(Oscillator { k: w * w }, 0.0, vec![1.0], vec![0.0], sc.hht).unwrap();
         let (mut t, mut x, mut finished) = (Vec::new(), Vec::new(), Vec::new());
-        step_and_record(&mut hht, &sc, &mut |_| true, |hht, event| {
+        step_and_record(&mut hht, &sc, &mut |_| true, None, |hht, event| {
             match event {
                 RecordEvent::Sample(k) => {
                     assert_eq!(k, t.len());
@@ -525,6 +411,7 @@ mod tests {
                     }
                     finished.push(k);
                 }
+                RecordEvent::Recorded(k, _) => assert_eq!(k + 1, t.len(), "after the sample"),
             }
             Ok(())
         })

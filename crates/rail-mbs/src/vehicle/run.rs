@@ -5,8 +5,11 @@
 use std::sync::Arc;
 use std::time::Instant;
 
+use super::checkpoint::{RunCheckpoints, VehicleCheckpoint};
 use super::tank_car::{CarBodies, CarPlacement, TankCarParams, add_coupler, add_tank_car};
-use crate::integrator::{AdaptiveParams, Hht, HhtParams, IntegratorError, Predictor, StepControl};
+use crate::integrator::{
+    AdaptiveParams, CheckpointFile, Hht, HhtParams, IntegratorError, MechanicalSystem, Predictor, StepControl,
+};
 use crate::mbs::{Multibody, SpeedProfile, Table};
 use crate::track::Track;
 use ancf_core::error::{AncfError, check_positive, invalid};
@@ -57,6 +60,11 @@ pub struct TrainScenario {
     pub snapshot_every: f64,
     /// Integrator parameters.
     pub hht: HhtParams,
+    /// Whole-run checkpoints written as the run goes ([`super::checkpoint`]; `None`: none).
+    pub checkpoints: Option<RunCheckpoints>,
+    /// A checkpoint of an earlier run of the same scenario and cargo to continue from
+    /// (`None`: start at t = 0). The record then starts at the checkpoint's sample.
+    pub resume_from: Option<std::path::PathBuf>,
 }
 
 impl TrainScenario {
@@ -105,6 +113,8 @@ impl TrainScenario {
             load_filter: LoadFilter::default(),
             snapshot_every: 0.0,
             hht: Self::default_hht(),
+            checkpoints: None,
+            resume_from: None,
         }
     }
 
@@ -180,13 +190,28 @@ pub use crate::observe::{Observer, Progress, RunFailure, SampleSink, stopped_by_
 pub const WHEEL_OFF_RAIL_LIMIT: f64 = 0.1;
 
 /// Watches every wheel's vertical load sample by sample ([`WHEEL_OFF_RAIL_LIMIT`]).
-#[derive(Debug, Default)]
+#[derive(Debug, Default, Clone)]
 struct WheelLiftWatch {
     /// Per wheelset and side: the time of the first sample of the current run without load.
     since: Vec<[Option<f64>; 2]>,
 }
 
 impl WheelLiftWatch {
+    /// The watch as a flat vector (a run checkpoint): per wheelset and side, 1 and the time,
+    /// or 0 and 0.
+    fn save(&self) -> Vec<f64> {
+        self.since.iter().flatten().flat_map(|s| [s.map_or(0.0, |_| 1.0), s.unwrap_or(0.0)]).collect()
+    }
+
+    /// The watch [`Self::save`] wrote; `None` when malformed.
+    fn restore(data: &[f64]) -> Option<Self> {
+        if !data.len().is_multiple_of(4) {
+            return None;
+        }
+        let side = |c: &[f64]| (c[0] == 1.0).then_some(c[1]);
+        Some(Self { since: data.chunks_exact(4).map(|c| [side(&c[..2]), side(&c[2..])]).collect() })
+    }
+
     /// Checks sample `k` of `rec`: a wheel with no load since longer than the limit is an error.
     fn check(&mut self, rec: &TrainRecord, k: usize) -> Result<(), IntegratorError> {
         let (Some(&t), Some(q)) = (rec.t.get(k), rec.wheel_vertical.get(k)) else { return Ok(()) };
@@ -245,6 +270,9 @@ pub(crate) trait TrainRun {
     fn set_loads(rec: &mut Self::Record, i: usize, loads: &[f64]);
     /// Sample `i` as one results-stream row.
     fn row(rec: &Self::Record, i: usize) -> Vec<f64>;
+    /// The recording's own state: the wheel/rail warm starts of the recorded samples (kept
+    /// in run checkpoints).
+    fn hints(&mut self) -> &mut Vec<f64>;
     /// Run data taken from the integrator at the end (e.g. the fluids' margins).
     fn finish(_hht: &Hht<Self::System>, _rec: &mut Self::Record) {}
 }
@@ -252,6 +280,10 @@ pub(crate) trait TrainRun {
 /// The run loop of every train run: builds the integrator on `sys` from `(q0, v0)`, steps and
 /// records through [`step_and_record`], streams each finished sample to `sink`, and returns
 /// the record, or the error with everything recorded up to it.
+///
+/// With `sc.checkpoints` it writes a [`VehicleCheckpoint`] after every `every`-th recorded
+/// sample; with `sc.resume_from` it starts from such a checkpoint instead of `(q0, v0)` and
+/// records from its sample on (the record's sample 0 is that sample).
 pub(crate) fn drive<R: TrainRun>(
     mut run: R,
     sys: R::System,
@@ -262,19 +294,53 @@ pub(crate) fn drive<R: TrainRun>(
     mut rec: R::Record,
 ) -> Result<R::Record, Box<RunFailure<R::Record>>> {
     let start = Instant::now();
-    let mut hht = match Hht::new(sys, 0.0, q0, v0, sc.hht) {
-        Ok(h) => h,
+    let mut wheels = WheelLiftWatch::default();
+    let built = match &sc.resume_from {
+        None => Hht::new(sys, 0.0, q0, v0, sc.hht).map(|h| (h, None)),
+        Some(path) => resume(sys, sc, path).map(|(h, cp)| {
+            *run.hints() = cp.recorder.clone();
+            (h, Some(cp))
+        }),
+    };
+    let (mut hht, resumed) = match built.and_then(|(h, cp)| match cp {
+        None => Ok((h, None)),
+        Some(cp) => {
+            let watch = WheelLiftWatch::restore(&cp.wheel_lift);
+            let hat = super::record::HatMean::restore(&cp.filter).filter(|_| !cp.filter.is_empty());
+            match (watch, hat.or_else(|| cp.filter.is_empty().then(Default::default))) {
+                (Some(w), Some(hat)) => {
+                    wheels = w;
+                    Ok((h, Some((cp.sample, hat))))
+                }
+                _ => Err(crate::integrator::bad_checkpoint("malformed wheel-lift or load-filter state")),
+            }
+        }
+    }) {
+        Ok(x) => x,
         Err(error) => {
             R::train(&mut rec).finish(None, start);
             return Err(Box::new(RunFailure { error, record: rec }));
         }
     };
+    // the record's sample 0 is the run's sample k0
+    let k0 = resumed.as_ref().map_or(0, |r| r.0);
+    let mut files = match sc.checkpoints.as_ref().map(|c| CheckpointFile::new(&c.path, 1).map(|f| (f, c.every))) {
+        Some(Err(error)) => {
+            R::train(&mut rec).finish(None, start);
+            return Err(Box::new(RunFailure { error, record: rec }));
+        }
+        other => other.map(Result::unwrap),
+    };
+    // the recorder's state before the latest sample (what a resumed run records it with)
+    let mut before: Option<(Vec<f64>, Vec<f64>)> = None;
     let mut scratch = R::Record::default();
-    let mut wheels = WheelLiftWatch::default();
-    let result = step_and_record(&mut hht, sc, observe, |hht, event| match event {
+    let result = step_and_record(&mut hht, sc, observe, resumed, |hht, event| match event {
         RecordEvent::Sample(k) => {
+            if files.is_some() {
+                before = Some((run.hints().clone(), wheels.save()));
+            }
             run.sample(hht, k, &mut rec, true)?;
-            wheels.check(R::train(&mut rec), k)
+            wheels.check(R::train(&mut rec), k - k0)
         }
         RecordEvent::Loads(out) => {
             R::clear_samples(&mut scratch);
@@ -285,13 +351,24 @@ pub(crate) fn drive<R: TrainRun>(
         }
         RecordEvent::Finish(k, loads) => {
             if let Some(l) = loads {
-                R::set_loads(&mut rec, k, l);
+                R::set_loads(&mut rec, k - k0, l);
             }
             match sink.as_mut() {
-                Some(sink) => sink(&R::row(&rec, k)),
+                Some(sink) => sink(&R::row(&rec, k - k0)),
                 None => Ok(()),
             }
         }
+        RecordEvent::Recorded(k, hat) => match (files.as_mut(), before.take()) {
+            (Some((file, every)), Some((recorder, wheel_lift))) if (k + 1).is_multiple_of(*every) => {
+                let mut system = Vec::new();
+                hht.system().save_internal_state(&mut system);
+                let filter = if sc.load_filter == LoadFilter::HatMean { hat.save() } else { Vec::new() };
+                let cp =
+                    VehicleCheckpoint { sample: k, integrator: hht.checkpoint(), system, recorder, wheel_lift, filter };
+                file.write_bytes(&cp.to_bytes())
+            }
+            _ => Ok(()),
+        },
     });
     R::train(&mut rec).finish(Some(hht.stats()), start);
     R::finish(&hht, &mut rec);
@@ -299,6 +376,31 @@ pub(crate) fn drive<R: TrainRun>(
         Ok(()) => Ok(rec),
         Err(error) => Err(Box::new(RunFailure { error, record: rec })),
     }
+}
+
+/// The integrator and the checkpoint of a run resumed from the checkpoint file at `path` on
+/// `sys` (built from the same scenario and cargo as the run that wrote it).
+fn resume<S: crate::integrator::MechanicalSystem>(
+    sys: S,
+    sc: &TrainScenario,
+    path: &std::path::Path,
+) -> Result<(Hht<S>, VehicleCheckpoint), IntegratorError> {
+    let cp = VehicleCheckpoint::from_bytes(&CheckpointFile::read_bytes(path)?)?;
+    let mut hht = Hht::restore(sys, &cp.integrator, sc.hht).map_err(|e| {
+        crate::integrator::bad_checkpoint(format!(
+            "{} does not fit this train (another scenario or cargo?): {e}",
+            path.display()
+        ))
+    })?;
+    let mut data = &cp.system[..];
+    // the warm starts and accounts do not change the model: the stored Jacobians stay valid
+    if hht.system_observed().restore_internal_state(&mut data).is_none() || !data.is_empty() {
+        return Err(crate::integrator::bad_checkpoint(format!(
+            "the system state of {} does not fit this train (another scenario or cargo?)",
+            path.display()
+        )));
+    }
+    Ok((hht, cp))
 }
 
 /// The rigid-lading run ([`run_train`]): the vehicle channels only.
@@ -345,6 +447,9 @@ impl TrainRun for RigidRun<'_> {
     }
     fn row(rec: &TrainRecord, i: usize) -> Vec<f64> {
         rec.row(i)
+    }
+    fn hints(&mut self) -> &mut Vec<f64> {
+        &mut self.hints
     }
 }
 

@@ -674,4 +674,7 @@ impl TrainRun for EquivalentRun<'_> {
     fn row(rec: &EquivalentTrainRecord, i: usize) -> Vec<f64> {
         rec.row(i)
     }
+    fn hints(&mut self) -> &mut Vec<f64> {
+        &mut self.hints
+    }
 }

@@ -428,6 +428,22 @@ impl MechanicalSystem for FluidVehicle {
     /// below [`crate::invariants::MIN_VOLUME_RATIO`], or energy growth beyond what the
     /// tank walls put in (the liquid's energy in the global frame, the walls' work from
     /// the tank body's velocities). A step is accounted only when every fluid passes.
+    /// The rigid system's warm starts, then each fluid's invariant account.
+    fn save_internal_state(&self, out: &mut Vec<f64>) {
+        self.mb.save_internal_state(out);
+        for m in &self.monitors {
+            m.save_account(out);
+        }
+    }
+
+    fn restore_internal_state(&mut self, data: &mut &[f64]) -> Option<()> {
+        self.mb.restore_internal_state(data)?;
+        for m in &mut self.monitors {
+            m.restore_account(data)?;
+        }
+        Some(())
+    }
+
     fn check_step(&mut self, t: f64, q: &[f64], v: &[f64]) -> Result<(), SystemError> {
         let nr = self.n_rigid;
         let g = self.mb.gravity;

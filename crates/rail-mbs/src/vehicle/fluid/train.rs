@@ -353,6 +353,9 @@ impl TrainRun for FluidRun<'_> {
     fn row(rec: &FluidTrainRecord, i: usize) -> Vec<f64> {
         rec.row(i)
     }
+    fn hints(&mut self) -> &mut Vec<f64> {
+        &mut self.hints
+    }
     fn finish(hht: &Hht<FluidVehicle>, rec: &mut FluidTrainRecord) {
         rec.margins = hht.system().margins();
     }

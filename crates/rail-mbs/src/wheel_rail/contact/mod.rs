@@ -453,6 +453,36 @@ impl WheelRailContact {
         self.last_station = None;
     }
 
+    /// Appends the search's warm start (its points, whether they are exact, the station) to
+    /// `out`, as [`Self::restore_warm_start`] reads it back: a resumed run then searches from
+    /// where the interrupted one would have.
+    pub fn save_warm_start(&self, out: &mut Vec<f64>) {
+        out.push(self.previous.len() as f64);
+        out.extend(self.previous.iter().flatten());
+        out.push(if self.previous_exact { 1.0 } else { 0.0 });
+        out.push(self.last_station.map_or(0.0, |_| 1.0));
+        out.push(self.last_station.unwrap_or(0.0));
+    }
+
+    /// Reads a warm start written by [`Self::save_warm_start`] from the front of `data`,
+    /// advancing it; `None` when `data` is too short or malformed.
+    pub fn restore_warm_start(&mut self, data: &mut &[f64]) -> Option<()> {
+        let n = *data.first()?;
+        if !(n >= 0.0 && n.fract() == 0.0) {
+            return None;
+        }
+        let n = n as usize;
+        let rest = data.get(1..)?;
+        let (points, rest) = (rest.get(..4 * n)?, rest.get(4 * n..)?);
+        let [exact, has_station, station] = *rest.get(..3)? else { return None };
+        self.previous.clear();
+        self.previous.extend(points.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]));
+        self.previous_exact = exact == 1.0;
+        self.last_station = (has_station == 1.0).then_some(station);
+        *data = &rest[3..];
+        Some(())
+    }
+
     /// Previous solutions used for warm starts.
     pub fn previous_solutions(&self) -> &[[f64; 4]] {
         &self.previous
