@@ -80,6 +80,44 @@ pub struct Margins {
 }
 
 impl Margins {
+    /// The fields in declaration order (a run checkpoint, [`Self::from_array`]).
+    fn to_array(self) -> [f64; 8] {
+        [
+            self.worst_gap,
+            self.worst_gap_time,
+            self.gap_limit,
+            self.worst_energy_error,
+            self.worst_energy_time,
+            self.min_volume_ratio,
+            self.min_volume_ratio_time,
+            self.dissipated,
+        ]
+    }
+
+    /// [`Self::to_array`] read back.
+    fn from_array(a: [f64; 8]) -> Self {
+        let [
+            worst_gap,
+            worst_gap_time,
+            gap_limit,
+            worst_energy_error,
+            worst_energy_time,
+            min_volume_ratio,
+            min_volume_ratio_time,
+            dissipated,
+        ] = a;
+        Self {
+            worst_gap,
+            worst_gap_time,
+            gap_limit,
+            worst_energy_error,
+            worst_energy_time,
+            min_volume_ratio,
+            min_volume_ratio_time,
+            dissipated,
+        }
+    }
+
     /// Keeps the worst of a state's gap and smallest volume ratio (time `t`).
     pub fn note(&mut self, t: f64, gap: f64, j: f64) {
         if gap > self.worst_gap {
@@ -269,17 +307,7 @@ impl InvariantMonitor {
         out.extend(opt(self.last.map(|l| l.0)));
         out.push(self.last.map_or(0.0, |l| l.1));
         out.extend([self.input_work, self.abs_work, self.max_kinetic]);
-        let m = &self.margins;
-        out.extend([
-            m.worst_gap,
-            m.worst_gap_time,
-            m.gap_limit,
-            m.worst_energy_error,
-            m.worst_energy_time,
-            m.min_volume_ratio,
-            m.min_volume_ratio_time,
-            m.dissipated,
-        ]);
+        out.extend(self.margins.to_array());
         let l = self.last_measured;
         out.push(l.map_or(0.0, |_| 1.0));
         let l = l.unwrap_or(Measured { gap: 0.0, min_volume_ratio: 0.0, energy_error: 0.0, input_work: 0.0 });
@@ -295,17 +323,7 @@ impl InvariantMonitor {
         self.e0 = opt(d[0], d[1]);
         self.last = opt(d[2], d[3]).map(|t| (t, d[4]));
         [self.input_work, self.abs_work, self.max_kinetic] = [d[5], d[6], d[7]];
-        let m = &mut self.margins;
-        [
-            m.worst_gap,
-            m.worst_gap_time,
-            m.gap_limit,
-            m.worst_energy_error,
-            m.worst_energy_time,
-            m.min_volume_ratio,
-            m.min_volume_ratio_time,
-            m.dissipated,
-        ] = [d[8], d[9], d[10], d[11], d[12], d[13], d[14], d[15]];
+        self.margins = Margins::from_array(d[8..16].try_into().expect("8 values"));
         self.last_measured = (d[16] == 1.0).then_some(Measured {
             gap: d[17],
             min_volume_ratio: d[18],

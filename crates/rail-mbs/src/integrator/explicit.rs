@@ -201,10 +201,7 @@ impl ExplicitCheckpoint {
     pub fn from_bytes(bytes: &[u8]) -> Result<Self, IntegratorError> {
         use super::hht::checkpoint::{Reader, bad};
         let mut r = Reader { bytes, pos: 0 };
-        if r.take(8, "magic")? != EXPLICIT_MAGIC {
-            return Err(bad("not a railslosh explicit checkpoint (bad magic)"));
-        }
-        let version = u32::from_le_bytes(r.take(4, "version")?.try_into().expect("4 bytes"));
+        let version = r.header(EXPLICIT_MAGIC, "explicit")?;
         if version != EXPLICIT_VERSION {
             return Err(bad(format!("format version {version}, this build reads {EXPLICIT_VERSION}")));
         }

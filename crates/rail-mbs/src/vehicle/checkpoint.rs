@@ -74,10 +74,7 @@ impl VehicleCheckpoint {
     /// Reads bytes written by [`Self::to_bytes`].
     pub fn from_bytes(bytes: &[u8]) -> Result<Self, IntegratorError> {
         let mut r = BytesReader { bytes, pos: 0 };
-        if r.take(8, "magic")? != MAGIC {
-            return Err(bad_checkpoint("not a railslosh vehicle-run checkpoint (bad magic)"));
-        }
-        let version = u32::from_le_bytes(r.take(4, "version")?.try_into().expect("4 bytes"));
+        let version = r.header(MAGIC, "vehicle-run")?;
         if version != VERSION {
             return Err(bad_checkpoint(format!("vehicle-run checkpoint version {version}, expected {VERSION}")));
         }

@@ -119,6 +119,14 @@ impl Reader<'_> {
         self.pos = end;
         Ok(s)
     }
+    /// Checks the magic at the start of the bytes (`what`: the kind of checkpoint, in the
+    /// error) and returns the format version that follows it.
+    pub(crate) fn header(&mut self, magic: &[u8; 8], what: &str) -> Result<u32, IntegratorError> {
+        if self.take(8, "magic")? != magic {
+            return Err(bad(format!("not a railslosh {what} checkpoint (bad magic)")));
+        }
+        Ok(u32::from_le_bytes(self.take(4, "version")?.try_into().expect("4 bytes")))
+    }
     pub(crate) fn u64(&mut self, field: &str) -> Result<u64, IntegratorError> {
         let b = self.take(8, field)?;
         Ok(u64::from_le_bytes(b.try_into().expect("8 bytes")))
@@ -195,10 +203,7 @@ impl Checkpoint {
     /// [`IntegratorError::Checkpoint`] naming the field.
     pub fn from_bytes(bytes: &[u8]) -> Result<Self, IntegratorError> {
         let mut r = Reader { bytes, pos: 0 };
-        if r.take(8, "magic")? != MAGIC {
-            return Err(bad("not a railslosh HHT checkpoint (bad magic)"));
-        }
-        let version = u32::from_le_bytes(r.take(4, "version")?.try_into().expect("4 bytes"));
+        let version = r.header(MAGIC, "HHT")?;
         if version != VERSION && version != 1 {
             return Err(bad(format!("format version {version}, this build reads 1 and {VERSION}")));
         }
