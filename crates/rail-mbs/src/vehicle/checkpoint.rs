@@ -51,7 +51,7 @@ pub struct VehicleCheckpoint {
     /// The wheel-lift watch before sample `sample`: per wheelset and side, 1 and the time
     /// since which the wheel has carried no load, or 0 and 0.
     pub wheel_lift: Vec<f64>,
-    /// The load filter after sample `sample` (empty when unfiltered).
+    /// The load filter after sample `sample` (an unfiltered run's holds no integrals).
     pub filter: Vec<f64>,
 }
 

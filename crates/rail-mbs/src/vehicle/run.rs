@@ -190,7 +190,7 @@ pub use crate::observe::{Observer, Progress, RunFailure, SampleSink, stopped_by_
 pub const WHEEL_OFF_RAIL_LIMIT: f64 = 0.1;
 
 /// Watches every wheel's vertical load sample by sample ([`WHEEL_OFF_RAIL_LIMIT`]).
-#[derive(Debug, Default, Clone)]
+#[derive(Debug, Default)]
 struct WheelLiftWatch {
     /// Per wheelset and side: the time of the first sample of the current run without load.
     since: Vec<[Option<f64>; 2]>,
@@ -294,49 +294,36 @@ pub(crate) fn drive<R: TrainRun>(
     mut rec: R::Record,
 ) -> Result<R::Record, Box<RunFailure<R::Record>>> {
     let start = Instant::now();
-    let mut wheels = WheelLiftWatch::default();
-    let built = match &sc.resume_from {
-        None => Hht::new(sys, 0.0, q0, v0, sc.hht).map(|h| (h, None)),
-        Some(path) => resume(sys, sc, path).map(|(h, cp)| {
-            *run.hints() = cp.recorder.clone();
-            (h, Some(cp))
-        }),
-    };
-    let (mut hht, resumed) = match built.and_then(|(h, cp)| match cp {
-        None => Ok((h, None)),
-        Some(cp) => {
-            let watch = WheelLiftWatch::restore(&cp.wheel_lift);
-            let hat = super::record::HatMean::restore(&cp.filter).filter(|_| !cp.filter.is_empty());
-            match (watch, hat.or_else(|| cp.filter.is_empty().then(Default::default))) {
-                (Some(w), Some(hat)) => {
-                    wheels = w;
-                    Ok((h, Some((cp.sample, hat))))
-                }
-                _ => Err(crate::integrator::bad_checkpoint("malformed wheel-lift or load-filter state")),
-            }
-        }
-    }) {
+    let setup = (|| {
+        let files = sc.checkpoints.as_ref().map(|c| CheckpointFile::new(&c.path, c.every)).transpose()?;
+        let (hht, resumed) = match &sc.resume_from {
+            None => (Hht::new(sys, 0.0, q0, v0, sc.hht)?, None),
+            Some(path) => resume(sys, sc, path).map(|(h, r)| (h, Some(r)))?,
+        };
+        Ok((hht, resumed, files))
+    })();
+    let (mut hht, resumed, mut files) = match setup {
         Ok(x) => x,
         Err(error) => {
             R::train(&mut rec).finish(None, start);
             return Err(Box::new(RunFailure { error, record: rec }));
         }
     };
+    let mut wheels = WheelLiftWatch::default();
+    let resumed = resumed.map(|r| {
+        *run.hints() = r.recorder;
+        wheels = r.wheel_lift;
+        (r.sample, r.filter)
+    });
     // the record's sample 0 is the run's sample k0
     let k0 = resumed.as_ref().map_or(0, |r| r.0);
-    let mut files = match sc.checkpoints.as_ref().map(|c| CheckpointFile::new(&c.path, 1).map(|f| (f, c.every))) {
-        Some(Err(error)) => {
-            R::train(&mut rec).finish(None, start);
-            return Err(Box::new(RunFailure { error, record: rec }));
-        }
-        other => other.map(Result::unwrap),
-    };
-    // the recorder's state before the latest sample (what a resumed run records it with)
+    let every = sc.checkpoints.as_ref().map(|c| c.every);
+    // the recorder's state before a sample a checkpoint follows (what a resumed run records it with)
     let mut before: Option<(Vec<f64>, Vec<f64>)> = None;
     let mut scratch = R::Record::default();
     let result = step_and_record(&mut hht, sc, observe, resumed, |hht, event| match event {
         RecordEvent::Sample(k) => {
-            if files.is_some() {
+            if every.is_some_and(|e| (k + 1).is_multiple_of(e)) {
                 before = Some((run.hints().clone(), wheels.save()));
             }
             run.sample(hht, k, &mut rec, true)?;
@@ -359,10 +346,10 @@ pub(crate) fn drive<R: TrainRun>(
             }
         }
         RecordEvent::Recorded(k, hat) => match (files.as_mut(), before.take()) {
-            (Some((file, every)), Some((recorder, wheel_lift))) if (k + 1).is_multiple_of(*every) => {
+            (Some(file), Some((recorder, wheel_lift))) => {
                 let mut system = Vec::new();
                 hht.system().save_internal_state(&mut system);
-                let filter = if sc.load_filter == LoadFilter::HatMean { hat.save() } else { Vec::new() };
+                let filter = hat.save();
                 let cp =
                     VehicleCheckpoint { sample: k, integrator: hht.checkpoint(), system, recorder, wheel_lift, filter };
                 file.write_bytes(&cp.to_bytes())
@@ -378,13 +365,22 @@ pub(crate) fn drive<R: TrainRun>(
     }
 }
 
-/// The integrator and the checkpoint of a run resumed from the checkpoint file at `path` on
-/// `sys` (built from the same scenario and cargo as the run that wrote it).
+/// Where a resumed run's recording starts ([`VehicleCheckpoint`]): the sample, the load filter
+/// after it, and the recorder's warm starts and wheel-lift watch before it.
+struct Resumed {
+    sample: usize,
+    filter: super::record::HatMean,
+    recorder: Vec<f64>,
+    wheel_lift: WheelLiftWatch,
+}
+
+/// The integrator and the recording state of a run resumed from the checkpoint file at `path`
+/// on `sys` (built from the same scenario and cargo as the run that wrote it).
 fn resume<S: crate::integrator::MechanicalSystem>(
     sys: S,
     sc: &TrainScenario,
     path: &std::path::Path,
-) -> Result<(Hht<S>, VehicleCheckpoint), IntegratorError> {
+) -> Result<(Hht<S>, Resumed), IntegratorError> {
     let cp = VehicleCheckpoint::from_bytes(&CheckpointFile::read_bytes(path)?)?;
     let mut hht = Hht::restore(sys, &cp.integrator, sc.hht).map_err(|e| {
         crate::integrator::bad_checkpoint(format!(
@@ -400,7 +396,15 @@ fn resume<S: crate::integrator::MechanicalSystem>(
             path.display()
         )));
     }
-    Ok((hht, cp))
+    let (Some(filter), Some(wheel_lift)) =
+        (super::record::HatMean::restore(&cp.filter), WheelLiftWatch::restore(&cp.wheel_lift))
+    else {
+        return Err(crate::integrator::bad_checkpoint(format!(
+            "malformed load-filter or wheel-lift state in {}",
+            path.display()
+        )));
+    };
+    Ok((hht, Resumed { sample: cp.sample, filter, recorder: cp.recorder, wheel_lift }))
 }
 
 /// The rigid-lading run ([`run_train`]): the vehicle channels only.
