@@ -146,7 +146,7 @@ def check(name: str, value: Any, field: str | None = None) -> Any:
 _NOTE = re.compile(r"while processing '([^']+)'")
 
 
-def _native_argument(error: TypeError) -> str | None:
+def _native_argument(error: Exception) -> str | None:
     """The argument that a compiled function's extraction error is about: PyO3 names it only in a
     note (``while processing 't_end'``), which ``str(error)`` leaves out."""
     for note in getattr(error, "__notes__", ()):
