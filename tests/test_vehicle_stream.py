@@ -86,8 +86,24 @@ def test_slosh_run_resumed_from_its_checkpoint_continues_bitwise(tmp_path):
     k = int(np.flatnonzero(full["t"] == rest["t"][0])[0])
     assert 0 < k < len(full["t"]) - 1
     assert len(rest["t"]) == len(full["t"]) - k
-    for key in ("t", "force_tank", "moment_tank", "com_tank", "volume", "kinetic_energy", "max_penetration"):
+    # the checkpoint carries the energy account too (issue 18): energy error, input work and
+    # the invariants go on as in the uninterrupted run
+    assert ck.read_bytes()[:8] == b"RSLSLOCK"
+    for key in (
+        "t",
+        "force_tank",
+        "moment_tank",
+        "com_tank",
+        "volume",
+        "kinetic_energy",
+        "max_penetration",
+        "input_work",
+        "energy_error",
+        "containment_gap",
+        "min_volume_ratio",
+    ):
         assert np.array_equal(rest[key], full[key][k:]), key
+    assert rest["input_work"][0] != 0.0
     assert np.array_equal(rest["newton_iterations"][1:], full["newton_iterations"][k + 1 :])
     with pytest.raises(ValueError, match="resume_from"):
         rs.slosh.run(mesh, water, tank, motion, t_end=0.6, step=0.004, resume_from=tmp_path / "none.ckpt")
@@ -107,11 +123,11 @@ def test_explicit_slosh_run_resumed_from_its_checkpoint_continues_bitwise(tmp_pa
     ck = tmp_path / "explicit.ckpt"
     kw = dict(t_end=0.12, step=0.004, stepper="explicit")
     full = rs.slosh.run(mesh, water, tank, motion, **kw, checkpoint=ck, checkpoint_every=400)
-    assert ck.read_bytes()[:8] == b"RSLEXPCK"
+    assert ck.read_bytes()[:8] == b"RSLSLOCK"
     rest = rs.slosh.run(mesh, water, tank, motion, **kw, resume_from=ck)
     k = int(np.flatnonzero(full["t"] == rest["t"][0])[0])
     assert 0 < k < len(full["t"]) - 1
-    for key in ("t", "force_tank", "moment_tank", "com_tank", "volume", "kinetic_energy"):
+    for key in ("t", "force_tank", "moment_tank", "com_tank", "volume", "kinetic_energy", "input_work", "energy_error"):
         assert np.array_equal(rest[key], full[key][k:]), key
     with pytest.raises(ValueError, match="stepper"):
         rs.slosh.run(mesh, water, tank, motion, t_end=0.12, step=0.004, stepper="implicit", resume_from=ck)

@@ -214,11 +214,12 @@ def run(
     so a run that is interrupted -- killed, out of time -- loses nothing already computed; read it
     with :func:`read_stream`, which returns the arrays of this function.
 
-    ``checkpoint`` (a file path) keeps the integrator state of the run there, rewritten
-    atomically every ``checkpoint_every`` accepted steps. ``resume_from`` continues a run of the
-    same scene from such a file: the results start at the checkpoint time and are bitwise
-    identical to the uninterrupted run's from there on (the first sample reports 0 Newton
-    iterations). Together with ``stream`` this restarts long runs without losing or changing
+    ``checkpoint`` (a file path) keeps the state of the run there (the stepper's, and the
+    invariants' energy account and worst margins), rewritten atomically every
+    ``checkpoint_every`` accepted steps. ``resume_from`` continues a run of the same scene from
+    such a file: the results start at the checkpoint time and are bitwise identical to the
+    uninterrupted run's from there on, energy error and input work included (the first sample
+    reports 0 Newton iterations). Together with ``stream`` this restarts long runs without losing or changing
     anything.
 
     ``snapshot_every`` (s, 0 = none) keeps fluid mesh snapshots in the **tank frame**: the result's

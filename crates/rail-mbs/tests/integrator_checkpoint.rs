@@ -400,6 +400,68 @@ fn journaled_slosh_run_streams_every_recorded_sample_exactly() {
     std::fs::remove_file(&path).unwrap();
 }
 
+/// Issue 18: a slosh run's checkpoint file carries the invariants' account, so a resumed run
+/// (implicit or explicit) records every column of the uninterrupted run bit for bit, energy error
+/// and input work included, and ends with the same worst margins; a bare stepper checkpoint still
+/// resumes, with its energy account restarted at the checkpoint.
+#[test]
+fn a_resumed_slosh_run_goes_on_with_the_same_energy_account() {
+    use rail_mbs::integrator::ExplicitParams;
+    use rail_mbs::slosh::{SloshCheckpoint, SloshRecord, SloshRun};
+    let column = |name: &str| SloshRecord::COLUMNS.iter().position(|c| *c == name).unwrap();
+    for explicit in [false, true] {
+        let start = || {
+            if explicit {
+                SloshRun::new_explicit(slosh_system(), 0.0, ExplicitParams::default()).unwrap()
+            } else {
+                SloshRun::new(slosh_system(), 0.0, slosh_params()).unwrap()
+            }
+        };
+        let path = temp_path(&format!("slosh-account-{explicit}.ck"));
+        // checkpoints every 40 % of the run's steps (an explicit run counts its sub-steps)
+        let mut probe = start();
+        probe.run_to(0.3, 0.01).unwrap();
+        let every = probe.stepper.stats().steps * 2 / 5;
+        let mut full = start();
+        full.checkpoints = Some(CheckpointFile::new(&path, every).unwrap());
+        full.run_to(0.3, 0.01).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        let ck = SloshCheckpoint::from_bytes(&bytes).unwrap();
+        assert!(!ck.account.is_empty());
+        let resume =
+            |b: &[u8]| SloshRun::resume_from_bytes(slosh_system(), b, slosh_params(), ExplicitParams::default());
+        let mut rest = resume(&bytes).unwrap();
+        rest.run_to(0.3, 0.01).unwrap();
+        let k = full.record.t.iter().position(|&t| t == rest.record.t[0]).unwrap();
+        assert!(k > 0 && k + 1 < full.record.t.len(), "explicit {explicit}: checkpoint at sample {k}");
+        assert_eq!(rest.record.t.len(), full.record.t.len() - k);
+        for i in 0..rest.record.t.len() {
+            let (a, b) = (rest.record.row(i), full.record.row(k + i));
+            if i == 0 {
+                // the resumed first sample reports no Newton iterations; everything else is equal
+                let it = column("newton_iterations");
+                let drop_it =
+                    |r: Vec<f64>| r.into_iter().enumerate().filter(|&(j, _)| j != it).map(|x| x.1).collect::<Vec<_>>();
+                assert_eq!(bits(&drop_it(a)), bits(&drop_it(b)), "explicit {explicit}: first resumed sample");
+            } else {
+                assert_eq!(bits(&a), bits(&b), "explicit {explicit}: sample {}", k + i);
+            }
+        }
+        assert!(rest.record.input_work[0] != 0.0, "the account went on, not restarted");
+        assert_eq!(rest.invariants.margins(), full.invariants.margins());
+        // A bare stepper checkpoint (the format before the account was saved): the run resumes
+        // with the same loads, and an energy account that starts again at the checkpoint.
+        let mut bare = resume(&ck.stepper).unwrap();
+        bare.run_to(0.3, 0.01).unwrap();
+        assert_eq!(bits(&bare.record.volume), bits(&full.record.volume[k..]));
+        assert_eq!(bare.record.input_work[0], 0.0);
+        // an account of the wrong length is refused with a typed error
+        let short = SloshCheckpoint { stepper: ck.stepper.clone(), account: ck.account[1..].to_vec() };
+        assert!(matches!(resume(&short.to_bytes()), Err(IntegratorError::Checkpoint { .. })));
+        std::fs::remove_file(&path).unwrap();
+    }
+}
+
 #[test]
 fn adaptive_steps_stretch_to_the_requested_step_instead_of_leaving_a_sliver() {
     // A caller landing on output times asks for the remainder to the next one; when the

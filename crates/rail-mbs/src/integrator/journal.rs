@@ -144,23 +144,23 @@ impl CheckpointFile {
     /// Writes a checkpoint if `every` steps have passed since the last one; returns
     /// whether it wrote.
     pub fn maybe_write<S: MechanicalSystem>(&mut self, hht: &Hht<S>) -> Result<bool, IntegratorError> {
-        let steps = hht.stats().steps;
-        if steps < self.last_step + self.every {
-            return Ok(false);
-        }
-        self.write(&hht.checkpoint())?;
-        self.last_step = steps;
-        Ok(true)
+        self.maybe_write_bytes(hht.stats().steps, || hht.checkpoint().to_bytes())
     }
 
     /// Writes an explicit run's checkpoint if `every` steps have passed since the last one;
     /// returns whether it wrote.
     pub fn maybe_write_explicit<S: MechanicalSystem>(&mut self, e: &Explicit<S>) -> Result<bool, IntegratorError> {
-        let steps = e.stats().steps;
+        self.maybe_write_bytes(e.stats().steps, || e.checkpoint().to_bytes())
+    }
+
+    /// Writes the bytes `make` gives if `every` steps have passed since the last checkpoint,
+    /// `steps` being the run's count now (a run checkpoint of another format, such as a slosh
+    /// run's); returns whether it wrote.
+    pub fn maybe_write_bytes(&mut self, steps: usize, make: impl FnOnce() -> Vec<u8>) -> Result<bool, IntegratorError> {
         if steps < self.last_step + self.every {
             return Ok(false);
         }
-        self.write_bytes(&e.checkpoint().to_bytes())?;
+        self.write_bytes(&make())?;
         self.last_step = steps;
         Ok(true)
     }

@@ -6,12 +6,14 @@
 //! small-amplitude modes of a [`SloshSystem`] about a state at rest.
 
 pub mod analysis;
+pub mod checkpoint;
 pub mod linear_theory;
 pub mod modes;
 pub mod motion;
 pub mod scenario;
 pub mod system;
 
+pub use checkpoint::SloshCheckpoint;
 pub use modes::{LinearModes, linear_modes, mass_normalized_eigen};
 pub use motion::{PiecewiseAcceleration, PrescribedMotion, TankFrameInput, TankFrameSample, TankState};
 pub use scenario::SloshScenario;
@@ -251,10 +253,11 @@ pub struct SloshRun {
     /// Outputs so far.
     pub record: SloshRecord,
     /// Periodic checkpoints (`None`: none written): after every accepted step the file
-    /// is rewritten once `every` steps have passed since the last one (issue 8).
+    /// is rewritten once `every` steps have passed since the last one (issue 8), as a
+    /// [`SloshCheckpoint`] (the stepper's checkpoint and the invariants' account).
     pub checkpoints: Option<CheckpointFile>,
-    /// The run-time invariants, checked on every accepted step (issue 16). A resumed
-    /// run starts its energy account at the checkpoint.
+    /// The run-time invariants, checked on every accepted step (issue 16). A run resumed
+    /// from a [`SloshCheckpoint`] goes on with the account it saved.
     pub invariants: InvariantMonitor,
     /// Fluid snapshots (issue 19): time and the nodal coordinates in the **tank frame** (12
     /// per node: position and the three position gradients), taken every
@@ -324,7 +327,21 @@ impl SloshRun {
     }
 
     fn with_stepper(stepper: SloshStepper) -> Result<Self, IntegratorError> {
-        let invariants = stepper.system().invariant_monitor();
+        Self::with_account(stepper, None)
+    }
+
+    /// A run of `stepper` whose invariants go on from `account` (saved by
+    /// [`InvariantMonitor::save_account`]; `None`: a fresh account), with its first sample
+    /// recorded.
+    fn with_account(stepper: SloshStepper, account: Option<&[f64]>) -> Result<Self, IntegratorError> {
+        let mut invariants = stepper.system().invariant_monitor();
+        if let Some(mut data) = account
+            && (invariants.restore_account(&mut data).is_none() || !data.is_empty())
+        {
+            return Err(crate::integrator::bad_checkpoint(
+                "the invariants' account does not fit this run (a checkpoint of another slosh run?)",
+            ));
+        }
         let mut run = Self {
             stepper,
             record: SloshRecord::default(),
@@ -393,31 +410,55 @@ impl SloshRun {
         Self::with_stepper(SloshStepper::Implicit(hht))
     }
 
-    /// Resume from the bytes of a checkpoint file of either stepper (told apart by their
-    /// magic), continuing bit for bit; `implicit`/`explicit` are the stepper parameters of
-    /// the original run.
+    /// Resume from the bytes of a checkpoint file, continuing bit for bit; `implicit`/`explicit`
+    /// are the stepper parameters of the original run. A [`SloshCheckpoint`] (what
+    /// [`SloshRun::checkpoints`] writes) also restores the invariants' account, so energy error,
+    /// input work and worst margins go on as in the uninterrupted run. A bare stepper
+    /// checkpoint of either kind (told apart by their magics; what runs wrote before
+    /// 2026-11-28) is taken too, with a fresh account starting at the checkpoint.
     pub fn resume_from_bytes(
         system: SloshSystem,
         bytes: &[u8],
         implicit: HhtParams,
         explicit: ExplicitParams,
     ) -> Result<Self, IntegratorError> {
-        if bytes.starts_with(b"RSLEXPCK") {
-            let cp = crate::integrator::ExplicitCheckpoint::from_bytes(bytes)?;
+        let whole;
+        let (stepper_bytes, account) = if SloshCheckpoint::is_one(bytes) {
+            whole = SloshCheckpoint::from_bytes(bytes)?;
+            (&whole.stepper[..], Some(&whole.account[..]))
+        } else {
+            (bytes, None)
+        };
+        let stepper = if stepper_bytes.starts_with(b"RSLEXPCK") {
+            let cp = crate::integrator::ExplicitCheckpoint::from_bytes(stepper_bytes)?;
             let m_s = system.body.scalar_mass().clone();
-            let e = Explicit::restore(system, &m_s, &cp, explicit)?;
-            return Self::with_stepper(SloshStepper::Explicit(Box::new(e)));
-        }
-        Self::resume(system, &Checkpoint::from_bytes(bytes)?, implicit)
+            SloshStepper::Explicit(Box::new(Explicit::restore(system, &m_s, &cp, explicit)?))
+        } else {
+            SloshStepper::Implicit(Hht::restore(system, &Checkpoint::from_bytes(stepper_bytes)?, implicit)?)
+        };
+        Self::with_account(stepper, account)
+    }
+
+    /// This run's checkpoint now (what [`SloshRun::checkpoints`] writes).
+    pub fn checkpoint(&self) -> SloshCheckpoint {
+        let stepper = match &self.stepper {
+            SloshStepper::Implicit(hht) => hht.checkpoint().to_bytes(),
+            SloshStepper::Explicit(e) => e.checkpoint().to_bytes(),
+        };
+        let mut account = Vec::new();
+        self.invariants.save_account(&mut account);
+        SloshCheckpoint { stepper, account }
     }
 
     /// Write a checkpoint if one is due.
     fn checkpoint_if_due(&mut self) -> Result<(), IntegratorError> {
-        match (self.checkpoints.as_mut(), &self.stepper) {
-            (Some(c), SloshStepper::Implicit(hht)) => c.maybe_write(hht).map(|_| ()),
-            (Some(c), SloshStepper::Explicit(e)) => c.maybe_write_explicit(e).map(|_| ()),
-            (None, _) => Ok(()),
-        }
+        let steps = self.stepper.stats().steps;
+        let Some(mut file) = self.checkpoints.take() else {
+            return Ok(());
+        };
+        let written = file.maybe_write_bytes(steps, || self.checkpoint().to_bytes());
+        self.checkpoints = Some(file);
+        written.map(|_| ())
     }
 
     /// Integrate to `t_end` with steps of (at most) `h`, recording every step.

@@ -1,0 +1,77 @@
+//! Checkpoint of a whole slosh run (issue 18): the stepper's own checkpoint (implicit
+//! [`crate::integrator::Checkpoint`] or explicit [`crate::integrator::ExplicitCheckpoint`], told
+//! apart by their magics) and the run-time invariants' account ([`InvariantMonitor::save_account`]:
+//! energy reference, input work, worst margins), so that a resumed run goes on with the same
+//! energy balance, not a fresh one.
+//!
+//! Byte format: the magic `RSLSLOCK`, a version (u32 LE), the stepper checkpoint's bytes
+//! (u64 length, then the bytes), the account (u64 length, then f64 LE values).
+//!
+//! [`InvariantMonitor::save_account`]: crate::invariants::InvariantMonitor::save_account
+
+use crate::integrator::{BytesReader, BytesWriter, IntegratorError, bad_checkpoint};
+
+const MAGIC: &[u8; 8] = b"RSLSLOCK";
+const VERSION: u32 = 1;
+
+/// A slosh run's checkpoint (see the module docs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SloshCheckpoint {
+    /// The stepper's checkpoint, as its own `to_bytes` wrote it.
+    pub stepper: Vec<u8>,
+    /// The invariant monitor's account.
+    pub account: Vec<f64>,
+}
+
+impl SloshCheckpoint {
+    /// Whether `bytes` start with this format's magic.
+    pub fn is_one(bytes: &[u8]) -> bool {
+        bytes.starts_with(MAGIC)
+    }
+
+    /// Serializes to bytes (format in the module docs); `f64` values are exact.
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut w = BytesWriter(Vec::new());
+        w.0.extend_from_slice(MAGIC);
+        w.0.extend_from_slice(&VERSION.to_le_bytes());
+        w.u64(self.stepper.len() as u64);
+        w.0.extend_from_slice(&self.stepper);
+        w.vec(&self.account);
+        w.0
+    }
+
+    /// Reads bytes written by [`Self::to_bytes`].
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self, IntegratorError> {
+        let mut r = BytesReader { bytes, pos: 0 };
+        let version = r.header(MAGIC, "slosh-run")?;
+        if version != VERSION {
+            return Err(bad_checkpoint(format!("slosh-run checkpoint version {version}, expected {VERSION}")));
+        }
+        let n = r.usize("stepper length")?;
+        let stepper = r.take(n, "stepper")?.to_vec();
+        let account = r.vec("account")?;
+        if r.pos != bytes.len() {
+            return Err(bad_checkpoint(format!("{} bytes after the end", bytes.len() - r.pos)));
+        }
+        Ok(Self { stepper, account })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bytes_round_trip_and_damage_is_a_typed_error() {
+        let ck = SloshCheckpoint { stepper: b"RSLEXPCK-some-bytes".to_vec(), account: vec![1.5, -0.0, f64::MAX] };
+        let bytes = ck.to_bytes();
+        assert!(SloshCheckpoint::is_one(&bytes));
+        assert_eq!(SloshCheckpoint::from_bytes(&bytes).unwrap(), ck);
+        for cut in [4, 12, 20, bytes.len() - 1] {
+            assert!(matches!(SloshCheckpoint::from_bytes(&bytes[..cut]), Err(IntegratorError::Checkpoint { .. })));
+        }
+        let mut longer = bytes.clone();
+        longer.push(0);
+        assert!(matches!(SloshCheckpoint::from_bytes(&longer), Err(IntegratorError::Checkpoint { .. })));
+    }
+}
