@@ -132,6 +132,53 @@ def test_a_vehicle_run_reports_its_invariant_margins(tmp_path):
     assert m["dissipated"] >= 0.0
     ds = results.load(tmp_path / "ecp" / "results.nc")
     assert "margin_worst_gap" in ds.attrs and "margin_worst_energy_error" in ds.attrs
+    # tangent track, identical brakes: the lateral channels are watched, and clean this early
+    mirror = summary["mirror_symmetry"]
+    assert mirror["inputs"] == "mirror-symmetric" and mirror["lateral_valid_until"] is None
+    assert 0.0 <= mirror["worst_lateral_load"] < mirror["limit"]
+    assert "mirror_limit" in ds.attrs and "mirror_lateral_valid_until" not in ds.attrs
+
+
+def test_lateral_channels_of_a_mirror_symmetric_run_are_flagged_when_they_stray_from_zero():
+    """Issue 16: a liquid on mirror-symmetric inputs must keep a zero lateral load; the ECP scenes'
+    growing antisymmetric mode makes it grow after the surge, so run_scene reports when the
+    lateral load first exceeds 1e-4 of the liquid's weight (docs/validation.md, "The ECP scenes'
+    lateral channels") instead of presenting it as physics."""
+    from railslosh.constants import GRAVITY
+    from railslosh.scene.run import MIRROR_LOAD_LIMIT, mirror_symmetry
+
+    ecp = scene.load_scene(SCENES / "crude_ecp_braking_light.toml")
+    assert ecp.mirror_symmetric()
+    assert not scene.load_scene(SCENES / "crude_curve_60kmh.toml").mirror_symmetric()
+    assert not scene.load_scene(SCENES / "irregular_fra5_60kmh_three_piece.toml").mirror_symmetric()
+    assert not dataclasses.replace(ecp, wheelset_lateral_offset=0.002).mirror_symmetric()  # rigid lading only
+    canted = ecp.replace(track_rows=((0.0, 0.0, 0.0, 0.0, 0.025, 0.025), (4000.0, 0.0, 0.0, 0.0, 0.025, 0.025)))
+    assert not canted.mirror_symmetric()  # both rails tilted the same way (Table 1: left is -cant_left)
+    inward = ecp.replace(track_rows=((0.0, 0.0, 0.0, 0.0, 0.025, -0.025), (4000.0, 0.0, 0.0, 0.0, 0.025, -0.025)))
+    assert inward.mirror_symmetric()
+    mass = 35_000.0
+    limit = MIRROR_LOAD_LIMIT * mass * GRAVITY
+    t = np.linspace(0.0, 10.0, 101)
+    force = np.zeros((101, 2, 3))
+    force[:, 1, 1] = -0.01 * limit * np.exp(0.5 * t)  # crosses the limit at t = 2 ln 100 = 9.21 s
+    res = {"t": t, "fluid_force_tank": force, "fluid_mass": mass}
+    m = mirror_symmetry(res, ecp)
+    assert m is not None and m["limit"] == pytest.approx(limit)
+    assert m["lateral_valid_until"] == pytest.approx(9.3)  # the first sample over the limit
+    assert m["worst_time"] == 10.0 and m["worst_lateral_load"] == pytest.approx(0.01 * limit * np.exp(5.0))
+    assert m["relative"] == pytest.approx(m["worst_lateral_load"] / (mass * GRAVITY))
+    force[:, 1, 1] = 0.5 * limit
+    assert mirror_symmetry(res, ecp)["lateral_valid_until"] is None
+    assert mirror_symmetry(res, scene.load_scene(SCENES / "crude_curve_60kmh.toml")) is None
+    assert mirror_symmetry({"t": t}, ecp) is None  # no liquid loads (rigid lading)
+    # the report's margins table says it
+    from railslosh import report
+
+    attrs = {"mirror_limit": 34.3, "mirror_worst_lateral_load": 1300.0, "mirror_worst_time": 9.4}
+    (row,) = report._margins(attrs | {"mirror_lateral_valid_until": 5.38})
+    assert row["status_class"] == "bad" and "discretization error after 5.38" in row["status"]
+    (row,) = report._margins(attrs)
+    assert row["status_class"] == "ok"
 
 
 def test_swri_maneuvers_quick_form_passes():

@@ -185,3 +185,30 @@ def test_a_long_run_title_goes_on_its_own_line_and_stays_inside_the_figure(run_t
     fig.savefig(tmp_path / "f.png")  # lays the figure out
     box = fig._suptitle.get_window_extent()
     assert box.x0 >= 0 and box.x1 <= fig.bbox.width, (box, fig.bbox)
+
+
+def test_the_lateral_panels_of_a_mirror_symmetric_run_are_hatched_from_when_they_stray():
+    """Issue 16: when a mirror-symmetric run's lateral liquid load leaves zero
+    (``mirror_lateral_valid_until``, railslosh.scene.run.mirror_symmetry), the lateral panels of the
+    liquid force and centre of mass are hatched from that time and say why; the other panels, and a
+    run without the attribute, are not."""
+    t = np.linspace(0.0, 10.0, 501)
+    f = np.zeros((t.size, 2, 3))
+    f[:, :, 0] = 5e4 * np.sin(0.3 * t)[:, None]
+    f[:, :, 1] = 1e-3 * np.exp(1.5 * t)[:, None]
+    f[:, :, 2] = -3.4e5
+    res = {"t": t, "fluid_force_tank": f, "oil_com_tank": f / 3.4e7, "fluid_mass": 35e3}
+    res["mirror_symmetry"] = {"inputs": "mirror-symmetric", "limit": 34.3, "lateral_valid_until": 6.94}
+    ds = results.to_dataset(res)
+    assert ds.attrs["mirror_lateral_valid_until"] == 6.94
+
+    def notes(fig):
+        return {a.get_ylabel().split(" ")[0]: [x.get_text() for x in a.texts] for a in fig.axes}
+
+    for stem in ("fluid_force", "oil_com"):
+        texts = notes(plots.figure(ds, stem))
+        assert any("after 6.94 s" in x and "discretization error" in x for x in texts["Lateral"]), stem
+        assert not any("discretization" in x for k, v in texts.items() if k != "Lateral" for x in v), stem
+    del res["mirror_symmetry"]
+    clean = notes(plots.figure(results.to_dataset(res), "fluid_force"))
+    assert not any("discretization" in x for v in clean.values() for x in v)

@@ -37,6 +37,7 @@ from railslosh import (
 from railslosh._core import RailsloshError
 from railslosh.constants import GRAVITY
 from railslosh.progress import ProgressBar
+from railslosh.scene.run import MIRROR_LOAD_LIMIT
 from railslosh.slosh import SimulationError
 
 _DESCRIPTION = """\
@@ -237,6 +238,9 @@ def _cmd_run(args: argparse.Namespace) -> int:
     summary |= {k: res[k] for k in keys if k in res}
     if res.get("irregularity") is not None:  # the track irregularity: where it came from, its RMS per channel
         summary["irregularity"] = res["irregularity"].summary()
+    mirror = res.get("mirror_symmetry")
+    if mirror is not None:  # liquid on mirror-symmetric inputs: how far its lateral load strays from 0
+        summary["mirror_symmetry"] = mirror
     (out / "run.json").write_text(json.dumps(summary, indent=1, default=str), encoding="utf-8")
     print(
         f"  {st.get('steps', 0)} steps, {st.get('newton_iterations', 0)} Newton iterations, "
@@ -244,6 +248,16 @@ def _cmd_run(args: argparse.Namespace) -> int:
     )
     for p in written:
         print(f"  wrote {p}")
+    if mirror is not None and mirror["lateral_valid_until"] is not None:
+        print(
+            f"  warning: the inputs are mirror-symmetric, so the liquid's lateral load should stay 0; it exceeds "
+            f"{mirror['limit']:.3g} N ({MIRROR_LOAD_LIMIT:g} of the liquid's weight) "
+            f"from t = {mirror['lateral_valid_until']:.3g} s "
+            f"and reaches {mirror['worst_lateral_load']:.3g} N at {mirror['worst_time']:.3g} s: the lateral channels "
+            "after that time are discretization error (run.json `mirror_symmetry`; docs/validation.md, "
+            '"The ECP scenes\' lateral channels")',
+            file=sys.stderr,
+        )
     print(f"  next: railslosh report {out}")
     return status
 

@@ -275,6 +275,31 @@ def _shade_settling(ax: Any, ts: float, first: bool) -> None:
         )
 
 
+_MIRROR_ZERO = frozenset(("fluid_force_tank", "oil_com_tank"))
+"""Variables whose lateral component a mirror-symmetric run keeps at zero
+(:func:`railslosh.scene.run.mirror_symmetry`)."""
+
+
+def _shade_mirror(ax: Any, since: Any, t_end: float) -> None:
+    """Hatches a lateral panel from the time ``since`` (the results' ``mirror_lateral_valid_until``;
+    ``None``: nothing) on which a mirror-symmetric run's lateral values, zero in an exact solution,
+    exceed :data:`railslosh.scene.run.MIRROR_LOAD_LIMIT` of the liquid's weight."""
+    if since is None or not np.isfinite(float(since)) or float(since) >= t_end:
+        return
+    since = float(since)
+    ax.axvspan(since, t_end, facecolor="none", edgecolor="C3", hatch="///", lw=0, alpha=0.35, zorder=0)
+    ax.annotate(
+        f"mirror-symmetric run: lateral values after {since:.3g} s\nare discretization error (should be 0)",
+        (since, 0.02),
+        xycoords=("data", "axes fraction"),
+        xytext=(3, 2),
+        textcoords="offset points",
+        fontsize=7,
+        color="C3",
+        bbox={"fc": "white", "ec": "none", "alpha": 0.75, "pad": 1.0},
+    )
+
+
 def _focus(ax: Any, t: np.ndarray, ys: Sequence[np.ndarray], ts: float, refs: Sequence[float], unit: str) -> None:
     """Y range from the data after settling and the reference lines; settling-phase values
     beyond it are clipped, and the clip is said in the panel."""
@@ -343,6 +368,8 @@ def _draw(fig: Any, ds: Any, spec: tuple[str, str, tuple[str, ...], str]) -> Non
             ax.axhline(value * f, color="k", ls=ls, lw=1.0, label=text)
             refs.append(value * f)
         _shade_settling(ax, ts, k == 0)
+        if name in _MIRROR_ZERO and "component" in da.coords and str(da["component"].values) == "y":
+            _shade_mirror(ax, ds.attrs.get("mirror_lateral_valid_until"), float(np.nanmax(t, initial=0.0)))
         _focus(ax, t, ys, ts, refs, unit)
         floor = max(
             0.02 * float(np.nanmax(np.abs(values), initial=0.0)),

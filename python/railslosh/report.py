@@ -230,6 +230,18 @@ def _margins(a: dict[str, Any]) -> list[dict[str, str]]:
             lim_text,
             eps <= _ENERGY_GROWTH_LIMIT,
         )
+    if "mirror_limit" in a:  # liquid on mirror-symmetric inputs (railslosh.scene.run.mirror_symmetry)
+        from railslosh.scene.run import MIRROR_LOAD_LIMIT
+
+        since = a.get("mirror_lateral_valid_until")
+        row(
+            "Mirror symmetry: largest lateral liquid load (0 in an exact solution)",
+            f"{num(float(a.get('mirror_worst_lateral_load', math.nan)), 3)} N",
+            a.get("mirror_worst_time"),
+            f"≤ {num(float(a['mirror_limit']), 3)} N ({MIRROR_LOAD_LIMIT:g} of the liquid's weight)",
+            since is None,
+            "" if since is None else f": lateral channels are discretization error after {num(float(since), 4)} s",
+        )
     if "margin_dissipated" in a:
         e = float(a["margin_dissipated"])
         value = f"{num(e / 1e3, 4)} kJ" if abs(e) >= 1e4 else f"{num(e, 4)} J"

@@ -284,6 +284,9 @@ def to_dataset(res: Mapping[str, Any], scene: Any = None) -> Any:
     for k, v in (res.get("margins") or {}).items():
         if v is not None:  # None: not measured (vehicle runs keep no energy account)
             attrs[f"margin_{k}"] = v
+    for k, v in (res.get("mirror_symmetry") or {}).items():
+        if isinstance(v, int | float):  # None: the lateral channels never strayed (no attribute)
+            attrs[f"mirror_{k}"] = float(v)
     if res.get("error"):
         attrs["error"] = str(res["error"])
     if res.get("settle_time") is not None:

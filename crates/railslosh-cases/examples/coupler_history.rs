@@ -3,13 +3,16 @@
 //! `cargo run --release -p railslosh-cases --example coupler_history -- OIL NX NY NZ T_END STEP REAR_BRAKE_FACTOR OUT.csv [bulkheads]`,
 //! e.g. `-- light 6 4 2 10.5 2e-3 1.0 ecp.csv`. Columns: t (s), coupler (N, tension positive),
 //! fx1, fz1, fx2, fz2 (the liquid's load on tank 1 and 2, tank frame, N), cx1, cz1, cx2, cz2
-//! (the liquid's centre of mass, tank frame, m). Walls and stabilization as the ECP scenes.
+//! (the liquid's centre of mass, tank frame, m), fy1, fy2, cy1, cy2 (the lateral channels, which
+//! mirror symmetry keeps at zero in an exact solution). Walls and stabilization as the ECP scenes;
+//! `STAB=β` multiplies the recommended shear stabilization by β (docs/validation.md, "The ECP
+//! scenes' lateral channels").
 use std::io::Write;
 
 use rail_mbs::defaults::Oil;
 use rail_mbs::integrator::LinearSolverKind;
 use rail_mbs::vehicle::{BrakeScope, TrainScenario};
-use railslosh_cases::vehicle::studies::{BrakingCase, run_braking_with};
+use railslosh_cases::vehicle::studies::{BrakingCase, run_braking_adjusted};
 use railslosh_cases::{SCENE_WALL_ADHESION, SCENE_WALL_DAMPING};
 
 fn main() {
@@ -32,16 +35,37 @@ fn main() {
         linear_solver: LinearSolverKind::Condensed,
         shear_stabilization: true,
     };
-    let r = run_braking_with(&case, number(5), TrainScenario::default_hht().rel_tol).expect("run");
+    let beta: f64 = std::env::var("STAB").map_or(1.0, |s| s.parse().expect("STAB: a number"));
+    let stabilize = |cg: &mut rail_mbs::vehicle::fluid::FluidCargo| {
+        // the value build_fluid_train chooses (half full: the depth is the tank radius), times β
+        let depth = rail_mbs::vehicle::TankCarParams::standard().expect("standard car").tank_radius;
+        let g_s =
+            rail_mbs::defaults::default_shear_stabilization(cg.fluid.density, depth / cg.counts[2] as f64, Some(depth));
+        cg.fluid.shear_stabilization = beta * g_s;
+    };
+    let r = run_braking_adjusted(&case, number(5), TrainScenario::default_hht().rel_tol, stabilize).expect("run");
     let s = &r.train;
     let mut f = std::fs::File::create(&a[7]).expect("OUT.csv");
-    writeln!(f, "t,coupler,fx1,fz1,fx2,fz2,cx1,cz1,cx2,cz2").unwrap();
+    writeln!(f, "t,coupler,fx1,fz1,fx2,fz2,cx1,cz1,cx2,cz2,fy1,fy2,cy1,cy2").unwrap();
     for i in 0..s.t.len() {
         let (l, c) = (&r.fluid_force_tank[i], &r.oil_com_tank[i]);
         writeln!(
             f,
-            "{},{},{},{},{},{},{},{},{},{}",
-            s.t[i], s.coupler_force[i][0], l[0][0], l[0][2], l[1][0], l[1][2], c[0][0], c[0][2], c[1][0], c[1][2]
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            s.t[i],
+            s.coupler_force[i][0],
+            l[0][0],
+            l[0][2],
+            l[1][0],
+            l[1][2],
+            c[0][0],
+            c[0][2],
+            c[1][0],
+            c[1][2],
+            l[0][1],
+            l[1][1],
+            c[0][1],
+            c[1][1]
         )
         .unwrap();
     }

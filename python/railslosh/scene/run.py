@@ -10,9 +10,43 @@ from typing import Any
 import numpy as np
 
 from railslosh import fluid_model, slosh, vehicle
+from railslosh.constants import GRAVITY
 from railslosh.scene.load import load_scene
 from railslosh.scene.slosh import SloshScene
 from railslosh.scene.vehicle import Scene
+
+MIRROR_LOAD_LIMIT = 1e-4
+"""Largest lateral liquid load, as a fraction of the liquid's weight, that a run with mirror-symmetric
+inputs (:meth:`Scene.mirror_symmetric`) may show before its lateral channels are flagged as
+discretization error (:func:`mirror_symmetry`): 1e-4 m g is 34 N for a tank of light crude, about
+0.1 % of the surge's peak longitudinal load on the ECP scenes."""
+
+
+def mirror_symmetry(res: Mapping[str, Any], sc: Scene) -> dict[str, Any] | None:
+    """For a vehicle run with liquid cargo whose inputs are mirror-symmetric
+    (:meth:`Scene.mirror_symmetric`), how far its liquid's lateral load strays from the exact zero:
+    ``worst_lateral_load`` (N, the largest over the cars and samples) at ``worst_time`` (s), as
+    ``relative`` to the liquid's weight; ``limit`` (N, :data:`MIRROR_LOAD_LIMIT` of that weight); and
+    ``lateral_valid_until``: the first sample time at which the load exceeds the limit, after which
+    the run's lateral channels (liquid lateral load and centre of mass, left against right wheel
+    loads) are discretization error, not physics (``docs/validation.md``, "The ECP scenes' lateral
+    channels"), or ``None`` when it never does. ``None`` for other runs."""
+    if not sc.mirror_symmetric() or "fluid_force_tank" not in res or not res.get("fluid_mass"):
+        return None
+    t = np.asarray(res["t"], dtype=float)
+    fy = np.abs(np.asarray(res["fluid_force_tank"], dtype=float)[..., 1]).max(axis=1)
+    weight = float(res["fluid_mass"]) * GRAVITY
+    limit = MIRROR_LOAD_LIMIT * weight
+    k = int(np.argmax(fy)) if len(fy) else 0
+    over = np.flatnonzero(fy > limit)
+    return {
+        "inputs": "mirror-symmetric",
+        "worst_lateral_load": float(fy[k]) if len(fy) else 0.0,
+        "worst_time": float(t[k]) if len(t) else 0.0,
+        "relative": float(fy[k] / weight) if len(fy) else 0.0,
+        "limit": limit,
+        "lateral_valid_until": float(t[over[0]]) if len(over) else None,
+    }
 
 
 def run_scene(
@@ -32,7 +66,9 @@ def run_scene(
     Vehicle scenes with liquid cargo run the fluid model of :func:`railslosh.fluid_model.decide`
     (``[fluid] slosh_model``); every vehicle result carries ``fluid_model`` and ``fluid_model_reason``,
     and the largest step the run took with the rule that chose it (``step``, ``step_reason``:
-    :meth:`Scene.largest_step`).
+    :meth:`Scene.largest_step`), and ``mirror_symmetry`` (:func:`mirror_symmetry`: for liquid cargo
+    on mirror-symmetric inputs, the largest lateral liquid load and when the lateral channels stop
+    being trustworthy; otherwise ``None``).
     ``checkpoint`` keeps the run's whole state in that file every ``checkpoint_every`` recorded
     samples; ``resume_from`` continues the same scene from such a file, its results starting at the
     checkpoint (bit for bit those of the uninterrupted run; :func:`railslosh.vehicle.run`,
@@ -62,7 +98,9 @@ def run_scene(
         exc.results.update(
             fluid_model=choice.model, fluid_model_reason=choice.reason, step=step, step_reason=step_reason
         )
+        exc.results["mirror_symmetry"] = mirror_symmetry(exc.results, sc)
         raise
     res |= {"fluid_model": choice.model, "fluid_model_reason": choice.reason, "step": step, "step_reason": step_reason}
+    res["mirror_symmetry"] = mirror_symmetry(res, sc)
     res["scene"] = sc
     return res

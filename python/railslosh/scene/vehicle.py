@@ -102,6 +102,21 @@ class Scene:
         """The track as a :class:`railslosh.rail.Track`."""
         return rail.Track.from_table(np.asarray(self.track_rows, dtype=float))
 
+    def mirror_symmetric(self) -> bool:
+        """Whether the run's inputs are mirror-symmetric about the track's vertical centre plane
+        (y → −y, ``docs/frames.md``): straight track without superelevation, rail cants mirrored
+        (``cant_right == −cant_left``, Table 1 convention), no irregularity, no friction map and no
+        wheelset offset. The cars, tanks, liquids and brakes are symmetric by construction, so every
+        lateral response of such a run (the liquid's lateral load and centre of mass, left against
+        right wheel loads) is zero in an exact solution (:func:`railslosh.scene.run.mirror_symmetry`)."""
+        rows = np.zeros((len(self.track_rows), 6))
+        for i, r in enumerate(self.track_rows):
+            rows[i, : len(r)] = r
+        straight = bool(np.all(rows[:, 1] == 0.0) and np.all(rows[:, 2] == 0.0))
+        cants = bool(np.all(rows[:, 4] == -rows[:, 5]))
+        perfect = self.irregularity is None or self.irregularity.get("kind") == "perfect"
+        return straight and cants and perfect and self.friction_map is None and self.wheelset_lateral_offset == 0.0
+
     def irregularity_spec(self) -> dict[str, Any] | None:
         """The track irregularity of ``[track.irregularities]`` for this train, defaults filled in (the
         spec of :func:`railslosh.irregularity.from_spec`: ``start`` 10 m ahead of the leading wheelset

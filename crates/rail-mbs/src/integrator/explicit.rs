@@ -201,10 +201,7 @@ impl ExplicitCheckpoint {
     pub fn from_bytes(bytes: &[u8]) -> Result<Self, IntegratorError> {
         use super::hht::checkpoint::{Reader, bad};
         let mut r = Reader { bytes, pos: 0 };
-        let version = r.header(EXPLICIT_MAGIC, "explicit")?;
-        if version != EXPLICIT_VERSION {
-            return Err(bad(format!("format version {version}, this build reads {EXPLICIT_VERSION}")));
-        }
+        r.versioned(EXPLICIT_MAGIC, "explicit", EXPLICIT_VERSION)?;
         let t = r.f64("t")?;
         let (q, v, a) = (r.vec("q")?, r.vec("v")?, r.vec("a")?);
         let (eigenvector, damped_vector) = (r.vec("eigenvector")?, r.vec("damped_vector")?);
@@ -217,9 +214,7 @@ impl ExplicitCheckpoint {
         };
         let since_estimate = r.usize("since_estimate")?;
         let stats = r.stats()?;
-        if r.pos != bytes.len() {
-            return Err(bad(format!("{} trailing bytes", bytes.len() - r.pos)));
-        }
+        r.finish()?;
         let n = q.len();
         if [v.len(), a.len(), eigenvector.len(), damped_vector.len()].iter().any(|&l| l != n) {
             return Err(bad(format!("q, v, a and the warm-start vectors differ in length (q has {n})")));

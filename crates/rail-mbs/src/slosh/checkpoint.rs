@@ -9,7 +9,7 @@
 //!
 //! [`InvariantMonitor::save_account`]: crate::invariants::InvariantMonitor::save_account
 
-use crate::integrator::{BytesReader, BytesWriter, IntegratorError, bad_checkpoint};
+use crate::integrator::{BytesReader, BytesWriter, IntegratorError};
 
 const MAGIC: &[u8; 8] = b"RSLSLOCK";
 const VERSION: u32 = 1;
@@ -43,16 +43,11 @@ impl SloshCheckpoint {
     /// Reads bytes written by [`Self::to_bytes`].
     pub fn from_bytes(bytes: &[u8]) -> Result<Self, IntegratorError> {
         let mut r = BytesReader { bytes, pos: 0 };
-        let version = r.header(MAGIC, "slosh-run")?;
-        if version != VERSION {
-            return Err(bad_checkpoint(format!("slosh-run checkpoint version {version}, expected {VERSION}")));
-        }
+        r.versioned(MAGIC, "slosh-run", VERSION)?;
         let n = r.usize("stepper length")?;
         let stepper = r.take(n, "stepper")?.to_vec();
         let account = r.vec("account")?;
-        if r.pos != bytes.len() {
-            return Err(bad_checkpoint(format!("{} bytes after the end", bytes.len() - r.pos)));
-        }
+        r.finish()?;
         Ok(Self { stepper, account })
     }
 }

@@ -22,7 +22,7 @@
 
 use std::path::PathBuf;
 
-use crate::integrator::{BytesReader, BytesWriter, Checkpoint, IntegratorError, bad_checkpoint};
+use crate::integrator::{BytesReader, BytesWriter, Checkpoint, IntegratorError};
 
 const MAGIC: &[u8; 8] = b"RSLVEHCK";
 const VERSION: u32 = 1;
@@ -74,18 +74,13 @@ impl VehicleCheckpoint {
     /// Reads bytes written by [`Self::to_bytes`].
     pub fn from_bytes(bytes: &[u8]) -> Result<Self, IntegratorError> {
         let mut r = BytesReader { bytes, pos: 0 };
-        let version = r.header(MAGIC, "vehicle-run")?;
-        if version != VERSION {
-            return Err(bad_checkpoint(format!("vehicle-run checkpoint version {version}, expected {VERSION}")));
-        }
+        r.versioned(MAGIC, "vehicle-run", VERSION)?;
         let sample = r.usize("sample")?;
         let n = r.usize("integrator length")?;
         let integrator = Checkpoint::from_bytes(r.take(n, "integrator")?)?;
         let (system, recorder, wheel_lift, filter) =
             (r.vec("system")?, r.vec("recorder")?, r.vec("wheel_lift")?, r.vec("filter")?);
-        if r.pos != bytes.len() {
-            return Err(bad_checkpoint(format!("{} bytes after the end", bytes.len() - r.pos)));
-        }
+        r.finish()?;
         Ok(Self { sample, integrator, system, recorder, wheel_lift, filter })
     }
 }

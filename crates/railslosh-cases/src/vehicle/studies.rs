@@ -102,12 +102,24 @@ pub fn run_braking(case: &BrakingCase) -> Result<FluidTrainRecord> {
 /// [`run_braking`] with a given largest time step `step` (s) and Newton relative
 /// tolerance `rel_tol` (the work–precision sweeps vary them).
 pub fn run_braking_with(case: &BrakingCase, step: f64, rel_tol: f64) -> Result<FluidTrainRecord> {
+    run_braking_adjusted(case, step, rel_tol, |_| {})
+}
+
+/// [`run_braking_with`] with the cargo changed by `adjust` before the run (studies of a
+/// setting `BrakingCase` does not carry, such as the shear stabilization's size).
+pub fn run_braking_adjusted(
+    case: &BrakingCase,
+    step: f64,
+    rel_tol: f64,
+    adjust: impl FnOnce(&mut FluidCargo),
+) -> Result<FluidTrainRecord> {
     let p = TankCarParams::standard()?;
     let mut cg = cargo(case.oil, case.counts, case.bulkheads, &p)?;
     cg.wall_damping_ratio = case.wall_damping_ratio;
     cg.wall_adhesion = case.wall_adhesion;
     cg.linear_solver = case.linear_solver;
     cg.shear_stabilization = case.shear_stabilization;
+    adjust(&mut cg);
     let v0 = 40.0 / 3.6;
     let mut sc = TrainScenario::single(p.clone(), tangent()?, 300.0, v0, case.t_end);
     sc.cars = case.cars;

@@ -127,6 +127,20 @@ impl Reader<'_> {
         }
         Ok(u32::from_le_bytes(self.take(4, "version")?.try_into().expect("4 bytes")))
     }
+    /// [`Self::header`] of a format that reads only `version`.
+    pub(crate) fn versioned(&mut self, magic: &[u8; 8], what: &str, version: u32) -> Result<(), IntegratorError> {
+        match self.header(magic, what)? {
+            v if v == version => Ok(()),
+            v => Err(bad(format!("{what} checkpoint format version {v}, this build reads {version}"))),
+        }
+    }
+    /// Checks that every byte was read.
+    pub(crate) fn finish(&self) -> Result<(), IntegratorError> {
+        match self.bytes.len() - self.pos {
+            0 => Ok(()),
+            n => Err(bad(format!("{n} trailing bytes"))),
+        }
+    }
     pub(crate) fn u64(&mut self, field: &str) -> Result<u64, IntegratorError> {
         let b = self.take(8, field)?;
         Ok(u64::from_le_bytes(b.try_into().expect("8 bytes")))
@@ -228,9 +242,7 @@ impl Checkpoint {
         let dv = r.vec("dv")?;
         let cq = r.vec("cq")?;
         let stats = r.stats()?;
-        if r.pos != bytes.len() {
-            return Err(bad(format!("{} trailing bytes", bytes.len() - r.pos)));
-        }
+        r.finish()?;
         let n = q.len();
         if v.len() != n || a.len() != n || a_prev.len() != n {
             return Err(bad(format!("q, v, a, a_prev have lengths {n}, {}, {}, {}", v.len(), a.len(), a_prev.len())));
