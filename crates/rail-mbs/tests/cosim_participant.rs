@@ -229,6 +229,7 @@ fn rollback_is_bitwise_exact() {
     };
     let first = run(&mut p);
     let com_first = p.com_tank();
+    let margins_first = p.margins();
     // a different trial (as an implicit master iterates), then back
     p.restore_state(&saved).unwrap();
     p.advance(t_saved + dt, &input(0.0), &input(1.0)).unwrap();
@@ -237,6 +238,10 @@ fn rollback_is_bitwise_exact() {
     let second = run(&mut p);
     assert_eq!(first, second, "loads after rollback must be bitwise identical");
     assert_eq!(com_first, p.com_tank());
+    // the state carries the invariants' account (issue 18): the energy balance and the worst
+    // margins go on from the saved state, not from a fresh account
+    assert_eq!(p.margins(), margins_first);
+    assert!(margins_first.dissipated != 0.0);
     // through the byte form
     let bytes = saved.to_bytes();
     let back = ParticipantState::from_bytes(&bytes).unwrap();
@@ -244,6 +249,10 @@ fn rollback_is_bitwise_exact() {
     p.restore_state(&back).unwrap();
     assert_eq!(run(&mut p), first);
     assert!(ParticipantState::from_bytes(&bytes[..20]).is_err());
+    assert!(ParticipantState::from_bytes(&bytes[..bytes.len() - 1]).is_err());
+    let mut longer = bytes.clone();
+    longer.push(0);
+    assert!(ParticipantState::from_bytes(&longer).is_err());
 }
 
 #[test]

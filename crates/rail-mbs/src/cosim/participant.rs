@@ -11,7 +11,7 @@ use ancf_core::tank::TankGeometry;
 use nalgebra::{Matrix3, Vector3};
 
 use crate::defaults::slosh_params;
-use crate::integrator::{Checkpoint, Hht, HhtParams, IntegratorError, Stats};
+use crate::integrator::{BytesReader, BytesWriter, Checkpoint, Hht, HhtParams, IntegratorError, Stats};
 use crate::invariants::{InvariantMonitor, Margins};
 use crate::slosh::{PrescribedMotion, SloshFrame, SloshSystem, TankFrameInput, TankFrameSample};
 
@@ -223,14 +223,18 @@ pub struct Loads {
 }
 
 /// Saved state of a [`SloshParticipant`] (opaque; [`ParticipantState::to_bytes`] for
-/// storage).
+/// storage): the integrator's checkpoint, the loads and the invariants' account, so that a
+/// restored participant goes on with the energy balance and margins it had (issue 18).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ParticipantState {
     checkpoint: Checkpoint,
     loads: Loads,
+    /// [`InvariantMonitor::save_account`].
+    account: Vec<f64>,
 }
 
-const STATE_MAGIC: &[u8; 8] = b"RSLCOSIM";
+const STATE_MAGIC: &[u8; 8] = b"RSLCOSM2";
+const STATE_VERSION: u32 = 1;
 
 impl ParticipantState {
     /// Time of the saved state (s).
@@ -238,26 +242,38 @@ impl ParticipantState {
         self.checkpoint.t
     }
 
-    /// Serialized form: magic `RSLCOSIM`, the 6 load components (f64 little-endian), then
-    /// the integrator checkpoint's own byte format. Exact.
+    /// Serialized form: magic `RSLCOSM2`, a version (u32 LE), the 6 load components (f64 LE),
+    /// the invariants' account (u64 length, f64 LE values), then the integrator checkpoint's
+    /// own byte format (u64 length, bytes). Exact. (The `RSLCOSIM` form before 2026-11-28,
+    /// without the account, is not read.)
     pub fn to_bytes(&self) -> Vec<u8> {
-        let mut out = STATE_MAGIC.to_vec();
-        for x in self.loads.force.iter().chain(&self.loads.moment) {
-            out.extend_from_slice(&x.to_le_bytes());
+        let mut w = BytesWriter(STATE_MAGIC.to_vec());
+        w.0.extend_from_slice(&STATE_VERSION.to_le_bytes());
+        for &x in self.loads.force.iter().chain(&self.loads.moment) {
+            w.f64(x);
         }
-        out.extend_from_slice(&self.checkpoint.to_bytes());
-        out
+        w.vec(&self.account);
+        let cp = self.checkpoint.to_bytes();
+        w.u64(cp.len() as u64);
+        w.0.extend_from_slice(&cp);
+        w.0
     }
 
     /// Inverse of [`to_bytes`](Self::to_bytes).
     pub fn from_bytes(bytes: &[u8]) -> Result<Self, CosimError> {
-        if bytes.len() < 56 || &bytes[..8] != STATE_MAGIC {
-            return Err(CosimError::State("not a slosh participant state (bad magic or too short)".into()));
+        let err = |e: IntegratorError| CosimError::State(e.to_string());
+        let mut r = BytesReader { bytes, pos: 0 };
+        r.versioned(STATE_MAGIC, "slosh participant", STATE_VERSION).map_err(err)?;
+        let mut l = [0.0; 6];
+        for (k, x) in l.iter_mut().enumerate() {
+            *x = r.f64(["force.x", "force.y", "force.z", "moment.x", "moment.y", "moment.z"][k]).map_err(err)?;
         }
-        let f = |k: usize| f64::from_le_bytes(bytes[8 + 8 * k..16 + 8 * k].try_into().expect("8 bytes"));
-        let loads = Loads { force: [f(0), f(1), f(2)], moment: [f(3), f(4), f(5)] };
-        let checkpoint = Checkpoint::from_bytes(&bytes[56..]).map_err(|e| CosimError::State(e.to_string()))?;
-        Ok(Self { checkpoint, loads })
+        let account = r.vec("account").map_err(err)?;
+        let n = r.usize("checkpoint length").map_err(err)?;
+        let checkpoint = Checkpoint::from_bytes(r.take(n, "checkpoint").map_err(err)?).map_err(err)?;
+        r.finish().map_err(err)?;
+        let loads = Loads { force: [l[0], l[1], l[2]], moment: [l[3], l[4], l[5]] };
+        Ok(Self { checkpoint, loads, account })
     }
 }
 
@@ -432,18 +448,27 @@ impl SloshParticipant {
 
     /// Saves the complete state for [`restore_state`](Self::restore_state).
     pub fn save_state(&self) -> ParticipantState {
-        ParticipantState { checkpoint: self.hht.checkpoint(), loads: self.loads }
+        let mut account = Vec::new();
+        self.invariants.save_account(&mut account);
+        ParticipantState { checkpoint: self.hht.checkpoint(), loads: self.loads, account }
     }
 
     /// Returns exactly to a saved state of this participant (or of one built from the
-    /// same configuration).
+    /// same configuration), its energy account and worst margins included: an implicit
+    /// coupling that iterates a window by restoring goes on with one energy balance over the
+    /// whole run.
     pub fn restore_state(&mut self, state: &ParticipantState) -> Result<(), CosimError> {
         let sys = self.hht.system().clone();
         let hht = Hht::restore(sys, &state.checkpoint, self.params).map_err(|e| CosimError::State(e.to_string()))?;
+        let mut invariants = hht.system().invariant_monitor();
+        let mut data = &state.account[..];
+        if invariants.restore_account(&mut data).is_none() || !data.is_empty() {
+            return Err(CosimError::State("the invariants' account does not fit this participant".into()));
+        }
         self.hht = hht;
         self.loads = state.loads;
-        let t = self.hht.t();
-        self.restart_energy().map_err(|e| integrator_error(t, t, e))
+        self.invariants = invariants;
+        Ok(())
     }
 
     fn current_loads(&self) -> Loads {
