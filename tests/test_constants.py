@@ -80,3 +80,14 @@ def test_the_liquids_and_penalty_rules_are_the_rust_defaults():
     assert fluids.water(depth=0.132, shear_stabilization=gs).shear_stabilization == gs > 0.0
     assert fluids.crude_oil("heavy", shear_stabilization=12.5).shear_stabilization == 12.5
     assert fluids.water().shear_stabilization == fluids.crude_oil("light").shear_stabilization == 0.0
+
+
+def test_the_non_affine_mode_control_is_a_fluid_parameter_named_in_its_errors():
+    """``Fluid(..., hourglass_stabilization=G_h)`` (Pa; 0 by default): the non-affine-mode control
+    of ``FluidBody`` (docs/validation.md, "The ECP scenes' lateral channels"); a negative value is
+    refused naming the field."""
+    f = rs.Fluid(850.0, "newtonian", viscosity=0.005, bulk_penalty=1.25e7, hourglass_stabilization=250.0)
+    assert f.hourglass_stabilization == 250.0
+    assert rs.Fluid(850.0, "newtonian", bulk_penalty=1.25e7).hourglass_stabilization == 0.0
+    with pytest.raises(ValueError, match="hourglass_stabilization"):
+        rs.Fluid(850.0, "newtonian", bulk_penalty=1.25e7, hourglass_stabilization=-1.0)

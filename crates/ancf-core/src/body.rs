@@ -12,6 +12,17 @@
 //! quadrature point of every element; after the point-wise stress update a second GEMM
 //! gives the forces. Chunks run in parallel (rayon) and are scattered in element order,
 //! so results are bitwise identical for any thread count.
+//!
+//! **Non-affine-mode control.** [`crate::Fluid::hourglass_stabilization`] G_h (Pa) adds the
+//! stored energy Σ_el ∫ G_h |F − F̄|² dV₀, F̄ the element's mean deformation gradient over the
+//! viscous rule. F is linear in the element coordinates, so this is ½ eᵀ (2 G_h H ⊗ I₃) e with a
+//! constant 32×32 H per element ([`crate::element::ElementRef::non_affine_compact`], built with
+//! the body): a constant stiffness added to the element forces and Jacobians, and its energy to
+//! [`FluidBody::stabilization_energy`]. It vanishes for every affine deformation of an element,
+//! large rotations, stretches and shears included, so unlike the shear stabilization (the
+//! deviatoric strain from the rest shape) it does not resist a liquid's large, smooth motion,
+//! only deformation that varies inside an element. It is objective (|R(F − F̄)| = |F − F̄|). Off
+//! by default; docs/validation.md, "The ECP scenes' lateral channels", measures it.
 
 use faer::linalg::matmul::matmul;
 use faer::sparse::{SparseColMat, Triplet};
@@ -111,6 +122,9 @@ pub struct FluidBody {
     gravity_scale: Vec<f64>,
     /// ∂n_a/∂ξ_J at all force points: row 3p + J, column a (viscous points, then penalty points).
     dn_t: Mat<f64>,
+    /// Per element, 2 G_h H (row-major 32×32, [`ElementRef::non_affine_compact`]): the
+    /// constant stiffness of the non-affine-mode control; empty when G_h = 0.
+    non_affine: Vec<Vec<f64>>,
 }
 
 impl FluidBody {
@@ -153,7 +167,16 @@ impl FluidBody {
                 }
             }
         }
-        Ok(Self { mesh, fluid, tables, elements, scalar_mass, gravity_scale, dn_t })
+        let gh = fluid.hourglass_stabilization;
+        let non_affine = if gh > 0.0 {
+            elements
+                .iter()
+                .map(|el| el.non_affine_compact(&tables).into_iter().map(|h| 2.0 * gh * h).collect())
+                .collect()
+        } else {
+            Vec::new()
+        };
+        Ok(Self { mesh, fluid, tables, elements, scalar_mass, gravity_scale, dn_t, non_affine })
     }
 
     /// Number of generalized coordinates (12 per node).
@@ -265,14 +288,29 @@ impl FluidBody {
 
     /// Stored energy of the shear stabilization, Σ ∫ G_s dev(E):dev(E) dV₀ (J); 0 without it.
     pub fn stabilization_energy(&self, e: &[f64]) -> f64 {
-        if self.fluid.shear_stabilization == 0.0 {
-            return 0.0;
+        let mut energy = 0.0;
+        if self.fluid.shear_stabilization != 0.0 {
+            energy += self
+                .elements
+                .iter()
+                .zip(&self.mesh.elements)
+                .map(|(el, nodes)| el.stabilization_energy(&gather_compact_flat(e, nodes), &self.tables, &self.fluid))
+                .sum::<f64>();
         }
-        self.elements
-            .iter()
-            .zip(&self.mesh.elements)
-            .map(|(el, nodes)| el.stabilization_energy(&gather_compact_flat(e, nodes), &self.tables, &self.fluid))
-            .sum()
+        for (k, nodes) in self.non_affine.iter().zip(&self.mesh.elements) {
+            let ec = gather_compact_flat(e, nodes);
+            let mut f = [0.0; N_COORDS];
+            add_non_affine(k, &ec, &mut f, None);
+            energy += 0.5 * (0..N_SHAPE).map(|a| (0..3).map(|i| ec[a][i] * f[3 * a + i]).sum::<f64>()).sum::<f64>();
+        }
+        energy
+    }
+
+    /// Adds the non-affine-mode control's force (and stiffness) of element `el`, if any.
+    fn non_affine_term(&self, el: usize, ec: &Compact, f: &mut [f64; N_COORDS], k: Option<&mut [f64]>) {
+        if let Some(m) = self.non_affine.get(el) {
+            add_non_affine(m, ec, f, k);
+        }
     }
 
     /// The smallest volume ratio J = det F over every quadrature point of every element
@@ -308,6 +346,7 @@ impl FluidBody {
         let ec = self.element_coordinates(el, e);
         let ed = self.element_coordinates(el, edot);
         self.elements[el].internal_force(el, &self.fluid, &self.tables, &ec, &ed, &mut f, Some((&mut k, &mut c)))?;
+        self.non_affine_term(el, &ec, &mut f, Some(&mut k));
         Ok((f, ElementJacobian { stiffness: k, damping: c }))
     }
 
@@ -337,7 +376,9 @@ impl FluidBody {
                 &ed,
                 &mut f,
                 Some((&mut jac.stiffness, &mut jac.damping)),
-            )
+            )?;
+            self.non_affine_term(el, &ec, &mut f, Some(&mut jac.stiffness));
+            Ok(())
         })
     }
 
@@ -352,6 +393,7 @@ impl FluidBody {
             let ec = gather_compact_flat(e, nodes);
             let ed = gather_compact_flat(edot, nodes);
             r.internal_force(el, &self.fluid, &self.tables, &ec, &ed, &mut f, None)?;
+            self.non_affine_term(el, &ec, &mut f, None);
             self.scatter(el, &f, out);
         }
         Ok(())
@@ -483,11 +525,34 @@ impl FluidBody {
                     out[b][3 * a + i] = scale[a] * fo[(a, 3 * b + i)];
                 }
             }
+            if !self.non_affine.is_empty() {
+                self.non_affine_term(el, &gather_compact_flat(e, &self.mesh.elements[el]), &mut out[b], None);
+            }
             if out[b].iter().any(|v| !v.is_finite()) {
                 return Err(AncfError::NonFinite { what: "element internal force".into(), element: el });
             }
         }
         Ok(())
+    }
+}
+
+/// f += K e and, with `k`, the 96×96 stiffness += K ⊗ I₃, for a compact 32×32 constant
+/// stiffness `m` (row-major, symmetric) and element coordinates `ec`.
+fn add_non_affine(m: &[f64], ec: &Compact, f: &mut [f64; N_COORDS], k: Option<&mut [f64]>) {
+    for a in 0..N_SHAPE {
+        let row = &m[a * N_SHAPE..(a + 1) * N_SHAPE];
+        for i in 0..3 {
+            f[3 * a + i] += (0..N_SHAPE).map(|b| row[b] * ec[b][i]).sum::<f64>();
+        }
+    }
+    if let Some(k) = k {
+        for a in 0..N_SHAPE {
+            for b in 0..N_SHAPE {
+                for i in 0..3 {
+                    k[(3 * a + i) * N_COORDS + 3 * b + i] += m[a * N_SHAPE + b];
+                }
+            }
+        }
     }
 }
 
@@ -599,6 +664,99 @@ mod tests {
             assert!(body.penalty_energy(e) > 0.0);
             assert!((du - fd).abs() < 1e-6 * fd.abs(), "dU = {du}, f.d = {fd}");
         }
+    }
+
+    /// The body's coordinates under x → A x + c (positions) and r_ξ → A r_ξ (gradients).
+    fn affine(e: &[f64], a: &M3, c: [f64; 3]) -> Vec<f64> {
+        let mut out = e.to_vec();
+        for (s, (o, x)) in out.chunks_exact_mut(3).zip(e.chunks_exact(3)).enumerate() {
+            let y = a * nalgebra::Vector3::new(x[0], x[1], x[2]);
+            let shift = if s % 4 == 0 { c } else { [0.0; 3] };
+            for i in 0..3 {
+                o[i] = y[i] + shift[i];
+            }
+        }
+        out
+    }
+
+    fn non_affine_body(gh: f64) -> (FluidBody, Vec<State>) {
+        let (mut body, states) = body_and_states(0.0);
+        let mut fluid = body.fluid;
+        fluid.rheology = Rheology::Newtonian { viscosity: 0.0 };
+        fluid.hourglass_stabilization = gh;
+        body = FluidBody::new(body.mesh.clone(), fluid, QuadratureOptions::default()).unwrap();
+        (body, states)
+    }
+
+    /// The non-affine-mode control: its force is the gradient of its stored energy (through
+    /// the batched and the scalar force paths alike), and its stiffness is that force's exact
+    /// derivative.
+    #[test]
+    fn non_affine_control_is_the_potential_of_its_force_and_its_stiffness_is_exact() {
+        let (body, states) = non_affine_body(50.0);
+        let n = body.n_coords();
+        let zero = vec![0.0; n];
+        let least = states.iter().map(|(e, _)| body.stabilization_energy(e)).fold(f64::INFINITY, f64::min);
+        assert!(body.stabilization_energy(&body.reference_coordinates()).abs() < 1e-10 * least);
+        for (e, v) in &states {
+            let (mut f, mut fs) = (vec![0.0; n], vec![0.0; n]);
+            body.internal_forces(e, &zero, &mut f).unwrap();
+            body.internal_forces_scalar(e, &zero, &mut fs).unwrap();
+            let scale = f.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            assert!(scale > 0.0 && f.iter().zip(&fs).all(|(a, b)| (a - b).abs() <= 1e-12 * scale));
+            // the energy is quadratic and the force linear in e: central differences are exact
+            // but for round-off, so a long step keeps that small
+            let h = 1e-2;
+            let at = |s: f64| body.stabilization_energy(&e.iter().zip(v).map(|(x, d)| x + s * d).collect::<Vec<_>>());
+            let du = (at(h) - at(-h)) / (2.0 * h);
+            let fd: f64 = f.iter().zip(v).map(|(a, b)| a * b).sum();
+            assert!(body.stabilization_energy(e) > 0.0);
+            assert!((du - fd).abs() < 1e-7 * fd.abs(), "dU = {du}, f.d = {fd}");
+            // the stiffness of element 3 against central differences of its force
+            let (_, jac) = body.element_tangent(3, e, &zero).unwrap();
+            let dv: Vec<f64> = (0..N_COORDS).map(|i| ((i * 3 % 7) as f64 - 3.0) / 7.0).collect();
+            let mut ep = e.clone();
+            let mut em = e.clone();
+            for (a, d) in dv.iter().enumerate() {
+                let g = body.global_index(3, a);
+                ep[g] += h * d;
+                em[g] -= h * d;
+            }
+            let (fp, _) = body.element_tangent(3, &ep, &zero).unwrap();
+            let (fm, _) = body.element_tangent(3, &em, &zero).unwrap();
+            for r in 0..N_COORDS {
+                let kd: f64 = (0..N_COORDS).map(|c| jac.stiffness[r * N_COORDS + c] * dv[c]).sum();
+                let fdr = (fp[r] - fm[r]) / (2.0 * h);
+                assert!((kd - fdr).abs() <= 1e-8 * (1.0 + fdr.abs()), "row {r}: K dv = {kd}, FD {fdr}");
+            }
+        }
+    }
+
+    /// The control stores no energy and exerts no force under any affine map of the
+    /// reference (a large rotation, stretch and shear, and a shift), is invariant under a
+    /// rigid rotation of a deformed state, and stores energy in a non-affine one.
+    #[test]
+    fn non_affine_control_ignores_affine_and_rigid_motions() {
+        let (body, states) = non_affine_body(50.0);
+        let n = body.n_coords();
+        let e0 = body.reference_coordinates();
+        let rot = *nalgebra::Rotation3::from_euler_angles(0.7, -0.4, 1.9).matrix();
+        let a = rot * M3::new(1.6, 0.5, -0.3, 0.1, 0.7, 0.4, 0.2, -0.2, 1.1);
+        let mapped = affine(&e0, &a, [3.0, -1.0, 0.5]);
+        let mut f = vec![0.0; n];
+        body.internal_forces(&mapped, &vec![0.0; n], &mut f).unwrap();
+        let (_, first) = &states[0];
+        let (deformed, _) = &states[2];
+        let e_scale = body.stabilization_energy(deformed);
+        assert!(e_scale > 0.0);
+        assert!(body.stabilization_energy(&mapped).abs() < 1e-10 * e_scale);
+        let mut f_def = vec![0.0; n];
+        body.internal_forces(deformed, &vec![0.0; n], &mut f_def).unwrap();
+        let f_scale = f_def.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        assert!(f.iter().all(|x| x.abs() < 1e-9 * f_scale));
+        let turned = affine(deformed, &rot, [0.0; 3]);
+        assert!((body.stabilization_energy(&turned) - e_scale).abs() < 1e-10 * e_scale);
+        assert!(first.len() == n);
     }
 
     /// The volume ratio range: 1 in the reference state, the extremes of a uniform

@@ -258,6 +258,10 @@ pub struct Fluid {
     /// Shear stabilization modulus G_s (Pa) of the zero-energy-mode control (module docs,
     /// "Shear stabilization"); 0 disables it.
     pub shear_stabilization: f64,
+    /// Modulus G_h (Pa) of the non-affine-mode control: the stored energy
+    /// ∫ G_h |F − F̄|² dV₀ per element, F̄ the element's mean deformation gradient
+    /// (`FluidBody`, "Non-affine-mode control"); 0 disables it. Read when the body is built.
+    pub hourglass_stabilization: f64,
 }
 
 impl Fluid {
@@ -272,6 +276,7 @@ impl Fluid {
             shear_rate_reg: 1e-2,
             oldroyd_switch_width: 0.05,
             shear_stabilization: 0.0,
+            hourglass_stabilization: 0.0,
         };
         f.validate()?;
         Ok(f)
@@ -286,6 +291,7 @@ impl Fluid {
         check_positive("shear_rate_reg", self.shear_rate_reg)?;
         check_range("oldroyd_switch_width", self.oldroyd_switch_width, 1e-4, 0.5)?;
         check_non_negative("shear_stabilization", self.shear_stabilization)?;
+        check_non_negative("hourglass_stabilization", self.hourglass_stabilization)?;
         Ok(())
     }
 

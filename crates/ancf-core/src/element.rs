@@ -246,6 +246,44 @@ impl ElementRef {
         m
     }
 
+    /// Compact 32×32 matrix H_ab = ∫ (g_a − ḡ_a)·(g_b − ḡ_b) dV₀ (row-major) over the
+    /// viscous rule, with g_a = ∂(s_a N_a)/∂X and ḡ_a its element mean: F − F̄ = Σ_a e_a ⊗ (g_a − ḡ_a),
+    /// so ∫ |F − F̄|² dV₀ = Σ_ab (e_a·e_b) H_ab. It vanishes on every affine deformation of the
+    /// element (and on rigid motions, which are affine), and only there.
+    pub fn non_affine_compact(&self, tables: &ShapeTables) -> Vec<f64> {
+        let g: Vec<[[f64; 3]; N_SHAPE]> = self
+            .viscous
+            .iter()
+            .enumerate()
+            .map(|(p, rp)| {
+                let dn = &tables.viscous.dn[p];
+                std::array::from_fn(|a| {
+                    let v = rp.jinv.transpose() * nalgebra::Vector3::new(dn[a][0], dn[a][1], dn[a][2]);
+                    [self.scale[a] * v[0], self.scale[a] * v[1], self.scale[a] * v[2]]
+                })
+            })
+            .collect();
+        let vol: f64 = self.viscous.iter().map(|rp| rp.wdet).sum();
+        let mut mean = [[0.0; 3]; N_SHAPE];
+        for (gp, rp) in g.iter().zip(&self.viscous) {
+            for a in 0..N_SHAPE {
+                for i in 0..3 {
+                    mean[a][i] += rp.wdet * gp[a][i] / vol;
+                }
+            }
+        }
+        let mut h = vec![0.0; N_SHAPE * N_SHAPE];
+        for (gp, rp) in g.iter().zip(&self.viscous) {
+            let d: [[f64; 3]; N_SHAPE] = std::array::from_fn(|a| std::array::from_fn(|i| gp[a][i] - mean[a][i]));
+            for a in 0..N_SHAPE {
+                for b in 0..N_SHAPE {
+                    h[a * N_SHAPE + b] += rp.wdet * (d[a][0] * d[b][0] + d[a][1] * d[b][1] + d[a][2] * d[b][2]);
+                }
+            }
+        }
+        h
+    }
+
     /// ∫ρ N_a dV₀ for each compact column: the gravity force is this times g.
     pub fn gravity_scale(&self, density: f64, tables: &ShapeTables) -> [f64; N_SHAPE] {
         let mut g = [0.0; N_SHAPE];

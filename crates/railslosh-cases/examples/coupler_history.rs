@@ -5,8 +5,8 @@
 //! fx1, fz1, fx2, fz2 (the liquid's load on tank 1 and 2, tank frame, N), cx1, cz1, cx2, cz2
 //! (the liquid's centre of mass, tank frame, m), fy1, fy2, cy1, cy2 (the lateral channels, which
 //! mirror symmetry keeps at zero in an exact solution). Walls and stabilization as the ECP scenes;
-//! `STAB=β` multiplies the recommended shear stabilization by β (docs/validation.md, "The ECP
-//! scenes' lateral channels").
+//! `STAB=β` multiplies the recommended shear stabilization by β (0: none) and `HG=η` adds the
+//! non-affine-mode control G_h = η ρ g H (docs/validation.md, "The ECP scenes' lateral channels").
 use std::io::Write;
 
 use rail_mbs::defaults::Oil;
@@ -42,6 +42,9 @@ fn main() {
         let g_s =
             rail_mbs::defaults::default_shear_stabilization(cg.fluid.density, depth / cg.counts[2] as f64, Some(depth));
         cg.fluid.shear_stabilization = beta * g_s;
+        cg.shear_stabilization = beta > 0.0; // β = 0: none (not the default)
+        let hg: f64 = std::env::var("HG").map_or(0.0, |s| s.parse().expect("HG: a number"));
+        cg.fluid.hourglass_stabilization = hg * cg.fluid.density * rail_mbs::track::GRAVITY * depth;
     };
     let r = run_braking_adjusted(&case, number(5), TrainScenario::default_hht().rel_tol, stabilize).expect("run");
     let s = &r.train;

@@ -53,6 +53,12 @@ fn main() {
         sys.body.fluid.rheology = working;
         // g < 0: the library default; else the multiple g of rho g H
         sys.body.fluid.shear_stabilization = if g >= 0.0 { g * rgh } else { g_default };
+        if let Ok(h) = std::env::var("HG") {
+            // the non-affine-mode control G_h = HG rho g H (read when the body is built)
+            let mut fluid = sys.body.fluid;
+            fluid.hourglass_stabilization = h.parse::<f64>().unwrap() * rgh;
+            sys.body = ancf_core::FluidBody::new(sys.body.mesh.clone(), fluid, quadrature).unwrap();
+        }
         let g = sys.body.fluid.shear_stabilization / rgh;
         let modes = linear_modes(&mut sys, ts, &q).unwrap();
         let lam: Vec<String> = modes.omega_sq.iter().take(4).map(|w| format!("{:.4}", w * depth / G)).collect();

@@ -275,7 +275,7 @@ struct PyFluid {
 args::named_readers!(fluid_arg {
     density: f64, viscosity: f64, yield_stress: f64, consistency: Option<f64>, power_index: f64,
     elastic_modulus: Option<f64>, bulk_penalty: f64, bulk_damping: f64, shear_rate_reg: f64,
-    shear_stabilization: f64,
+    shear_stabilization: f64, hourglass_stabilization: f64,
 });
 
 #[pymethods]
@@ -283,7 +283,7 @@ impl PyFluid {
     #[new]
     #[pyo3(signature = (density, model, *, viscosity=0.0, yield_stress=0.0, consistency=None, power_index=1.0,
                         elastic_modulus=None, bulk_penalty, bulk_damping=0.0, shear_rate_reg=1e-2,
-                        shear_stabilization=0.0))]
+                        shear_stabilization=0.0, hourglass_stabilization=0.0))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         #[pyo3(from_py_with = fluid_arg::density)] density: f64,
@@ -297,6 +297,7 @@ impl PyFluid {
         #[pyo3(from_py_with = fluid_arg::bulk_damping)] bulk_damping: f64,
         #[pyo3(from_py_with = fluid_arg::shear_rate_reg)] shear_rate_reg: f64,
         #[pyo3(from_py_with = fluid_arg::shear_stabilization)] shear_stabilization: f64,
+        #[pyo3(from_py_with = fluid_arg::hourglass_stabilization)] hourglass_stabilization: f64,
     ) -> PyResult<Self> {
         let rheology = match model {
             "newtonian" => Rheology::Newtonian { viscosity },
@@ -320,6 +321,7 @@ impl PyFluid {
             shear_rate_reg,
             oldroyd_switch_width: 0.05,
             shear_stabilization,
+            hourglass_stabilization,
         };
         f.validate().map_err(to_py)?;
         Ok(Self { inner: f })
@@ -348,6 +350,11 @@ impl PyFluid {
     #[getter]
     fn shear_stabilization(&self) -> f64 {
         self.inner.shear_stabilization
+    }
+    /// Non-affine-mode control modulus G_h, Pa (0: none).
+    #[getter]
+    fn hourglass_stabilization(&self) -> f64 {
+        self.inner.hourglass_stabilization
     }
     /// Shear modulus of the Oldroyd elastic branch (0 for other models).
     #[getter]
