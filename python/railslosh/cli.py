@@ -37,7 +37,7 @@ from railslosh import (
 from railslosh._core import RailsloshError
 from railslosh.constants import GRAVITY
 from railslosh.progress import ProgressBar
-from railslosh.scene.run import MIRROR_LOAD_LIMIT
+from railslosh.scene.run import MIRROR_LOAD_LIMIT as _MIRROR_LOAD_LIMIT
 from railslosh.slosh import SimulationError
 
 _DESCRIPTION = """\
@@ -251,7 +251,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
     if mirror is not None and mirror["lateral_valid_until"] is not None:
         print(
             f"  warning: the inputs are mirror-symmetric, so the liquid's lateral load should stay 0; it exceeds "
-            f"{mirror['limit']:.3g} N ({MIRROR_LOAD_LIMIT:g} of the liquid's weight) "
+            f"{mirror['limit']:.3g} N ({_MIRROR_LOAD_LIMIT:g} of the liquid's weight) "
             f"from t = {mirror['lateral_valid_until']:.3g} s "
             f"and reaches {mirror['worst_lateral_load']:.3g} N at {mirror['worst_time']:.3g} s: the lateral channels "
             "after that time are discretization error (run.json `mirror_symmetry`; docs/validation.md, "
