@@ -626,6 +626,15 @@ mod tests {
         (body, states)
     }
 
+    /// The force `f` at `e` is the gradient of `energy` along `v`: central differences of step
+    /// `h` agree with f·v within `tol` relative.
+    fn assert_potential(energy: impl Fn(&[f64]) -> f64, e: &[f64], v: &[f64], f: &[f64], h: f64, tol: f64) {
+        let at = |s: f64| energy(&e.iter().zip(v).map(|(x, d)| x + s * d).collect::<Vec<_>>());
+        let du = (at(h) - at(-h)) / (2.0 * h);
+        let fd: f64 = f.iter().zip(v).map(|(a, b)| a * b).sum();
+        assert!((du - fd).abs() < tol * fd.abs(), "dU = {du}, f.d = {fd}");
+    }
+
     /// A reused workspace gives bit-identical forces to fresh buffers, state after state,
     /// with and without the penalty terms (whose skipped rows must stay zero).
     #[test]
@@ -657,12 +666,8 @@ mod tests {
         for (e, v) in &states {
             let mut f = vec![0.0; n];
             body.internal_forces(e, &vec![0.0; n], &mut f).unwrap();
-            let h = 1e-6;
-            let at = |s: f64| body.penalty_energy(&e.iter().zip(v).map(|(x, d)| x + s * d).collect::<Vec<_>>());
-            let du = (at(h) - at(-h)) / (2.0 * h);
-            let fd: f64 = f.iter().zip(v).map(|(a, b)| a * b).sum();
             assert!(body.penalty_energy(e) > 0.0);
-            assert!((du - fd).abs() < 1e-6 * fd.abs(), "dU = {du}, f.d = {fd}");
+            assert_potential(|x| body.penalty_energy(x), e, v, &f, 1e-6, 1e-6);
         }
     }
 
@@ -706,12 +711,9 @@ mod tests {
             assert!(scale > 0.0 && f.iter().zip(&fs).all(|(a, b)| (a - b).abs() <= 1e-12 * scale));
             // the energy is quadratic and the force linear in e: central differences are exact
             // but for round-off, so a long step keeps that small
-            let h = 1e-2;
-            let at = |s: f64| body.stabilization_energy(&e.iter().zip(v).map(|(x, d)| x + s * d).collect::<Vec<_>>());
-            let du = (at(h) - at(-h)) / (2.0 * h);
-            let fd: f64 = f.iter().zip(v).map(|(a, b)| a * b).sum();
             assert!(body.stabilization_energy(e) > 0.0);
-            assert!((du - fd).abs() < 1e-7 * fd.abs(), "dU = {du}, f.d = {fd}");
+            assert_potential(|x| body.stabilization_energy(x), e, v, &f, 1e-2, 1e-7);
+            let h = 1e-2;
             // the stiffness of element 3 against central differences of its force
             let (_, jac) = body.element_tangent(3, e, &zero).unwrap();
             let dv: Vec<f64> = (0..N_COORDS).map(|i| ((i * 3 % 7) as f64 - 3.0) / 7.0).collect();
