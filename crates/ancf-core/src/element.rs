@@ -165,6 +165,16 @@ pub struct ElementRef {
 /// Element coordinates in compact form: `e[a]` is the 3-vector of compact column `a`.
 pub type Compact = [[f64; 3]; N_SHAPE];
 
+/// B_a = Ĵ₀⁻ᵀ ∂n_a/∂ξ at a point, the reference gradient of each scaled shape function
+/// (so ∂F_iJ/∂ê_{a,i} = B_a,J).
+#[inline]
+fn shape_gradients(rp: &RefPoint, dn: &[[f64; 3]; N_SHAPE]) -> [[f64; 3]; N_SHAPE] {
+    std::array::from_fn(|a| {
+        let v = rp.jinv.transpose() * Vector3::new(dn[a][0], dn[a][1], dn[a][2]);
+        [v[0], v[1], v[2]]
+    })
+}
+
 /// Gradient ∂X/∂ξ of scaled compact coordinates at a point.
 #[inline]
 fn grad_xi(ehat: &Compact, dn: &[[f64; 3]; N_SHAPE]) -> M3 {
@@ -256,11 +266,8 @@ impl ElementRef {
             .iter()
             .enumerate()
             .map(|(p, rp)| {
-                let dn = &tables.viscous.dn[p];
-                std::array::from_fn(|a| {
-                    let v = rp.jinv.transpose() * nalgebra::Vector3::new(dn[a][0], dn[a][1], dn[a][2]);
-                    [self.scale[a] * v[0], self.scale[a] * v[1], self.scale[a] * v[2]]
-                })
+                let b = shape_gradients(rp, &tables.viscous.dn[p]);
+                std::array::from_fn(|a| b[a].map(|x| self.scale[a] * x))
             })
             .collect();
         let vol: f64 = self.viscous.iter().map(|rp| rp.wdet).sum();
@@ -469,12 +476,7 @@ impl ElementRef {
             for (p, (rp, dn)) in pts.iter().zip(&table.dn).enumerate() {
                 let f = grad_xi(&ehat, dn) * rp.jinv;
                 let fd = grad_xi(&edhat, dn) * rp.jinv;
-                // B_a = Ĵ₀⁻ᵀ ∂n_a/∂ξ (so ∂F_iJ/∂ê_{a,i} = B_a,J)
-                let mut bmat = [[0.0; 3]; N_SHAPE];
-                for a in 0..N_SHAPE {
-                    let v = rp.jinv.transpose() * Vector3::new(dn[a][0], dn[a][1], dn[a][2]);
-                    bmat[a] = [v[0], v[1], v[2]];
-                }
+                let bmat = shape_gradients(rp, dn);
                 let pk = if deviatoric {
                     let t = if want_t { Some((&mut tf, &mut tv)) } else { None };
                     fluid.deviatoric_stress_with(&f, &fd, t, deviatoric_path).ok_or(AncfError::InvertedElement {
