@@ -334,6 +334,13 @@ impl InvariantMonitor {
         Some(())
     }
 
+    /// [`Self::restore_account`] of exactly one account: `None` when `data` is shorter or
+    /// longer (an account of another run).
+    pub fn restore_whole_account(&mut self, mut data: &[f64]) -> Option<()> {
+        self.restore_account(&mut data)?;
+        data.is_empty().then_some(())
+    }
+
     /// What the last accounted state measured (None before the first).
     pub fn last_measured(&self) -> Option<Measured> {
         self.last_measured

@@ -247,15 +247,13 @@ impl ParticipantState {
     /// own byte format (u64 length, bytes). Exact. (The `RSLCOSIM` form before 2026-11-28,
     /// without the account, is not read.)
     pub fn to_bytes(&self) -> Vec<u8> {
-        let mut w = BytesWriter(STATE_MAGIC.to_vec());
-        w.0.extend_from_slice(&STATE_VERSION.to_le_bytes());
+        let mut w = BytesWriter(Vec::new());
+        w.header(STATE_MAGIC, STATE_VERSION);
         for &x in self.loads.force.iter().chain(&self.loads.moment) {
             w.f64(x);
         }
         w.vec(&self.account);
-        let cp = self.checkpoint.to_bytes();
-        w.u64(cp.len() as u64);
-        w.0.extend_from_slice(&cp);
+        w.bytes(&self.checkpoint.to_bytes());
         w.0
     }
 
@@ -269,8 +267,7 @@ impl ParticipantState {
             *x = r.f64(["force.x", "force.y", "force.z", "moment.x", "moment.y", "moment.z"][k]).map_err(err)?;
         }
         let account = r.vec("account").map_err(err)?;
-        let n = r.usize("checkpoint length").map_err(err)?;
-        let checkpoint = Checkpoint::from_bytes(r.take(n, "checkpoint").map_err(err)?).map_err(err)?;
+        let checkpoint = Checkpoint::from_bytes(r.bytes("checkpoint").map_err(err)?).map_err(err)?;
         r.finish().map_err(err)?;
         let loads = Loads { force: [l[0], l[1], l[2]], moment: [l[3], l[4], l[5]] };
         Ok(Self { checkpoint, loads, account })
@@ -461,8 +458,7 @@ impl SloshParticipant {
         let sys = self.hht.system().clone();
         let hht = Hht::restore(sys, &state.checkpoint, self.params).map_err(|e| CosimError::State(e.to_string()))?;
         let mut invariants = hht.system().invariant_monitor();
-        let mut data = &state.account[..];
-        if invariants.restore_account(&mut data).is_none() || !data.is_empty() {
+        if invariants.restore_whole_account(&state.account).is_none() {
             return Err(CosimError::State("the invariants' account does not fit this participant".into()));
         }
         self.hht = hht;

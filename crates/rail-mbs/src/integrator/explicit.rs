@@ -179,8 +179,7 @@ impl ExplicitCheckpoint {
     pub fn to_bytes(&self) -> Vec<u8> {
         use super::hht::checkpoint::Writer;
         let mut w = Writer(Vec::with_capacity(128 + 8 * 5 * self.q.len()));
-        w.0.extend_from_slice(EXPLICIT_MAGIC);
-        w.0.extend_from_slice(&EXPLICIT_VERSION.to_le_bytes());
+        w.header(EXPLICIT_MAGIC, EXPLICIT_VERSION);
         w.f64(self.t);
         for x in [&self.q, &self.v, &self.a, &self.eigenvector, &self.damped_vector] {
             w.vec(x);

@@ -32,10 +32,8 @@ impl SloshCheckpoint {
     /// Serializes to bytes (format in the module docs); `f64` values are exact.
     pub fn to_bytes(&self) -> Vec<u8> {
         let mut w = BytesWriter(Vec::new());
-        w.0.extend_from_slice(MAGIC);
-        w.0.extend_from_slice(&VERSION.to_le_bytes());
-        w.u64(self.stepper.len() as u64);
-        w.0.extend_from_slice(&self.stepper);
+        w.header(MAGIC, VERSION);
+        w.bytes(&self.stepper);
         w.vec(&self.account);
         w.0
     }
@@ -44,8 +42,7 @@ impl SloshCheckpoint {
     pub fn from_bytes(bytes: &[u8]) -> Result<Self, IntegratorError> {
         let mut r = BytesReader { bytes, pos: 0 };
         r.versioned(MAGIC, "slosh-run", VERSION)?;
-        let n = r.usize("stepper length")?;
-        let stepper = r.take(n, "stepper")?.to_vec();
+        let stepper = r.bytes("stepper")?.to_vec();
         let account = r.vec("account")?;
         r.finish()?;
         Ok(Self { stepper, account })

@@ -335,8 +335,8 @@ impl SloshRun {
     /// recorded.
     fn with_account(stepper: SloshStepper, account: Option<&[f64]>) -> Result<Self, IntegratorError> {
         let mut invariants = stepper.system().invariant_monitor();
-        if let Some(mut data) = account
-            && (invariants.restore_account(&mut data).is_none() || !data.is_empty())
+        if let Some(data) = account
+            && invariants.restore_whole_account(data).is_none()
         {
             return Err(crate::integrator::bad_checkpoint(
                 "the invariants' account does not fit this run (a checkpoint of another slosh run?)",

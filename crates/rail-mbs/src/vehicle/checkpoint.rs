@@ -59,12 +59,9 @@ impl VehicleCheckpoint {
     /// Serializes to bytes (format in the module docs); `f64` values are exact.
     pub fn to_bytes(&self) -> Vec<u8> {
         let mut w = BytesWriter(Vec::new());
-        w.0.extend_from_slice(MAGIC);
-        w.0.extend_from_slice(&VERSION.to_le_bytes());
+        w.header(MAGIC, VERSION);
         w.u64(self.sample as u64);
-        let hht = self.integrator.to_bytes();
-        w.u64(hht.len() as u64);
-        w.0.extend_from_slice(&hht);
+        w.bytes(&self.integrator.to_bytes());
         for v in [&self.system, &self.recorder, &self.wheel_lift, &self.filter] {
             w.vec(v);
         }
@@ -76,8 +73,7 @@ impl VehicleCheckpoint {
         let mut r = BytesReader { bytes, pos: 0 };
         r.versioned(MAGIC, "vehicle-run", VERSION)?;
         let sample = r.usize("sample")?;
-        let n = r.usize("integrator length")?;
-        let integrator = Checkpoint::from_bytes(r.take(n, "integrator")?)?;
+        let integrator = Checkpoint::from_bytes(r.bytes("integrator")?)?;
         let (system, recorder, wheel_lift, filter) =
             (r.vec("system")?, r.vec("recorder")?, r.vec("wheel_lift")?, r.vec("filter")?);
         r.finish()?;

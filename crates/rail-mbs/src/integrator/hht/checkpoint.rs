@@ -66,6 +66,16 @@ pub struct Checkpoint {
 pub(crate) struct Writer(pub(crate) Vec<u8>);
 
 impl Writer {
+    /// The magic of a format and its version (read back by [`Reader::header`]).
+    pub(crate) fn header(&mut self, magic: &[u8; 8], version: u32) {
+        self.0.extend_from_slice(magic);
+        self.0.extend_from_slice(&version.to_le_bytes());
+    }
+    /// Bytes of a nested format, length first (read back by [`Reader::bytes`]).
+    pub(crate) fn bytes(&mut self, x: &[u8]) {
+        self.u64(x.len() as u64);
+        self.0.extend_from_slice(x);
+    }
     pub(crate) fn u64(&mut self, x: u64) {
         self.0.extend_from_slice(&x.to_le_bytes());
     }
@@ -141,6 +151,11 @@ impl Reader<'_> {
             n => Err(bad(format!("{n} trailing bytes"))),
         }
     }
+    /// Bytes written by [`Writer::bytes`].
+    pub(crate) fn bytes(&mut self, field: &str) -> Result<&[u8], IntegratorError> {
+        let n = self.usize(field)?;
+        self.take(n, field)
+    }
     pub(crate) fn u64(&mut self, field: &str) -> Result<u64, IntegratorError> {
         let b = self.take(8, field)?;
         Ok(u64::from_le_bytes(b.try_into().expect("8 bytes")))
@@ -191,8 +206,7 @@ impl Checkpoint {
     /// Serializes to bytes (format in the module docs). `f64` values are exact.
     pub fn to_bytes(&self) -> Vec<u8> {
         let mut w = Writer(Vec::with_capacity(64 + 8 * (4 * self.q.len() + 4 * self.dq.len())));
-        w.0.extend_from_slice(MAGIC);
-        w.0.extend_from_slice(&VERSION.to_le_bytes());
+        w.header(MAGIC, VERSION);
         w.f64(self.t);
         for x in [&self.q, &self.v, &self.a, &self.lambda] {
             w.vec(x);
