@@ -321,6 +321,58 @@ fn the_tank_car_mesh_fills_its_heads() {
     }
 }
 
+/// The node (position, then ∂X/∂u, ∂X/∂v, ∂X/∂w) at which `mesh` puts the mirror image of node
+/// `k` about the plane of coordinate `axis`, and that image (the parametric direction `axis`
+/// reversed), when some node lies there.
+fn mirror_partner(mesh: &ancf_core::mesh::FluidMesh, k: usize, axis: usize) -> Option<(usize, [f64; 12])> {
+    let n = &mesh.nodes[k];
+    let mut image = *n;
+    for (slot, c) in image.iter_mut().enumerate() {
+        if (slot % 3 == axis) != (slot / 3 == axis + 1) {
+            *c = -*c;
+        }
+    }
+    let dist = |m: &[f64; 12]| (0..3).map(|c| (m[c] - image[c]).powi(2)).sum::<f64>().sqrt();
+    let j = (0..mesh.n_nodes()).min_by(|&a, &b| dist(&mesh.nodes[a]).total_cmp(&dist(&mesh.nodes[b])))?;
+    (dist(&mesh.nodes[j]) < 1e-9).then_some((j, image))
+}
+
+/// A tank symmetric about y = 0 (and about x = 0 without bulkheads) gets a mesh whose mirror
+/// nodes carry mirrored coordinates to the bit, gradients included. The map's finite
+/// differences alone left the tank car's head-rim gradients 1.7e-5 apart (√(1 − ρ²) amplifies
+/// a rounding of ρ²), the seed of the ECP scenes' lateral load (docs/validation.md, "The ECP
+/// scenes' lateral channels").
+#[test]
+fn symmetric_tanks_get_meshes_symmetric_to_the_bit() {
+    use ancf_core::mesh::{cylinder_tank_compartments, elliptic_cylinder};
+    let car = |counts: [usize; 3]| CylinderTankSpec { length: 11.0, ..CylinderTankSpec::tank_car(counts) };
+    let cases = [
+        ("tank car 6x4x2", cylinder_tank(&car([6, 4, 2])).unwrap(), vec![0, 1]),
+        ("tank car 3x6x3", cylinder_tank(&car([3, 6, 3])).unwrap(), vec![0, 1]),
+        (
+            "flat-ended cylinder 5x4x2",
+            cylinder_tank(&CylinderTankSpec { head_depth: 0.0, ..car([5, 4, 2]) }).unwrap(),
+            vec![0, 1],
+        ),
+        ("SwRI 3x6x3", elliptic_cylinder(&EllipticCylinderSpec::swri(3, 6, 3)).unwrap(), vec![0, 1]),
+        ("two bulkheads", cylinder_tank_compartments(&car([9, 4, 2]), &[(-2.0, 0.02), (1.0, 0.02)]).unwrap(), vec![1]),
+    ];
+    for (name, mesh, axes) in cases {
+        for axis in axes {
+            for k in 0..mesh.n_nodes() {
+                let (j, image) =
+                    mirror_partner(&mesh, k, axis).unwrap_or_else(|| panic!("{name}: node {k} has no mirror"));
+                for (c, (&got, &want)) in mesh.nodes[j].iter().zip(&image).enumerate() {
+                    assert!(
+                        got == want,
+                        "{name}, axis {axis}: node {j} coordinate {c} is {got:e}, the mirror of node {k} {want:e}"
+                    );
+                }
+            }
+        }
+    }
+}
+
 #[test]
 fn tank_geometry_free_surface_and_volume_converge() {
     let mut errs = Vec::new();
