@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from railslosh import cli, results, robustness, scene, slosh
+from railslosh import cli, fluids, results, robustness, scene, slosh
 
 SCENES = Path(__file__).resolve().parents[1] / "examples" / "scenes"
 INVARIANT_CAUSES = {"containment", "distorted_element", "inverted_element", "energy_growth"}
@@ -203,6 +203,48 @@ def test_a_braked_tank_car_keeps_a_zero_lateral_load_from_the_start():
     weight = float(np.abs(np.asarray(res["force_tank"], dtype=float)[-1, 2]))
     assert weight > 0.9 * 35_000.0 * GRAVITY  # the liquid rests on the tank (about 343 kN)
     assert fy.max() < 1e-9 * weight, f"lateral load {fy.max():.3g} N on a mirror-symmetric run"
+    # slosh runs are watched as vehicle runs are
+    mirror = res["mirror_symmetry"]
+    assert mirror["inputs"] == "mirror-symmetric" and mirror["lateral_valid_until"] is None
+    assert mirror["worst_lateral_load"] == pytest.approx(fy.max())
+    assert mirror["limit"] == pytest.approx(1e-4 * res["scene"].liquid_mass() * GRAVITY)
+
+
+def test_slosh_runs_on_mirror_symmetric_inputs_are_watched_too():
+    """Issue 16: the lateral-load watch of vehicle runs covers slosh scenes: a tank symmetric about
+    y = 0 moved without lateral acceleration and turned (if at all) about y keeps a zero lateral load
+    (the SwRI bumps, pulses along x or z); a lane change is mirrored into the other lane, so it is
+    not watched, nor is a box off-centre in y."""
+    from railslosh.constants import GRAVITY
+    from railslosh.scene.run import MIRROR_LOAD_LIMIT, mirror_symmetry
+
+    bump = scene.load_scene(SCENES / "swri_bump_trapezoid_9in_15mph.toml")
+    assert bump.motion().rotation_axis is not None and bump.mirror_symmetric()  # heave and pitch
+    assert not scene.load_scene(SCENES / "swri_lane_change_40mph.toml").mirror_symmetric()
+    doc = {
+        "tank": {"shape": "box", "lower": [-0.208, -0.162, 0.0], "upper": [0.208, 0.162, 0.3]},
+        "fluid": {"oil": "water", "fill": 0.44},
+        "mesh": {"counts": [2, 2, 1]},
+        "solver": {"t_end": 0.2, "step": 0.01},
+        "maneuver": {"type": "pulse", "axis": "x", "acceleration": 1.0, "t0": 0.05, "t1": 0.15, "ramp": 0.02},
+    }
+    box = scene.load_scene(doc)
+    assert box.mirror_symmetric()
+    assert box.liquid_mass() == pytest.approx(fluids.LIQUIDS["water"][0] * 0.416 * 0.324 * 0.132, rel=1e-12)
+    doc["maneuver"]["axis"] = "y"
+    assert not scene.load_scene(doc).mirror_symmetric()
+    doc["maneuver"]["axis"] = "z"
+    assert scene.load_scene(doc).mirror_symmetric()
+    doc["tank"]["lower"] = [-0.208, -0.160, 0.0]
+    assert not scene.load_scene(doc).mirror_symmetric()
+    # flagged from the first sample over 1e-4 of the liquid's weight
+    limit = MIRROR_LOAD_LIMIT * box.liquid_mass() * GRAVITY
+    t = np.linspace(0.0, 1.0, 11)
+    force = np.zeros((11, 3))
+    force[6:, 1] = 2.0 * limit
+    m = mirror_symmetry({"t": t, "force_tank": force}, box)
+    assert m["limit"] == pytest.approx(limit) and m["lateral_valid_until"] == pytest.approx(0.6)
+    assert mirror_symmetry({"t": t, "force_tank": force}, scene.load_scene(doc)) is None
 
 
 def test_swri_maneuvers_quick_form_passes():

@@ -212,3 +212,22 @@ def test_the_lateral_panels_of_a_mirror_symmetric_run_are_hatched_from_when_they
     del res["mirror_symmetry"]
     clean = notes(plots.figure(results.to_dataset(res), "fluid_force"))
     assert not any("discretization" in x for v in clean.values() for x in v)
+
+
+def test_the_lateral_panels_of_a_mirror_symmetric_slosh_run_are_hatched_too():
+    """Issue 16: slosh runs on mirror-symmetric inputs are watched as vehicle runs are
+    (railslosh.scene.run.mirror_symmetry), so their lateral force and centre-of-mass panels carry
+    the same hatch from the time the lateral load strays."""
+    t = np.linspace(0.0, 2.0, 201)
+    f = np.zeros((t.size, 3))
+    f[:, 0] = 5.0 * np.sin(3.0 * t)
+    f[:, 1] = 1e-6 * np.exp(8.0 * t)
+    f[:, 2] = -21.4
+    res = {"t": t, "force_tank": f, "com_tank": f / 100.0}
+    res["mirror_symmetry"] = {"inputs": "mirror-symmetric", "limit": 0.0137, "lateral_valid_until": 1.2}
+    ds = results.to_dataset(res)
+    for stem in ("slosh_force", "slosh_com"):
+        fig = plots.figure(ds, stem)
+        texts = {a.get_ylabel().split(" ")[0]: [x.get_text() for x in a.texts] for a in fig.axes}
+        assert any("after 1.2 s" in x and "discretization error" in x for x in texts["Lateral"]), stem
+        assert not any("discretization" in x for k, v in texts.items() if k != "Lateral" for x in v), stem

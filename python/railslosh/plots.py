@@ -275,8 +275,8 @@ def _shade_settling(ax: Any, ts: float, first: bool) -> None:
         )
 
 
-_MIRROR_ZERO = frozenset(("fluid_force_tank", "oil_com_tank"))
-"""Variables whose lateral component a mirror-symmetric run keeps at zero
+_MIRROR_ZERO = frozenset(("fluid_force_tank", "oil_com_tank", "force_tank", "com_tank"))
+"""Variables whose lateral component a mirror-symmetric run (vehicle or slosh) keeps at zero
 (:func:`railslosh.scene.run.mirror_symmetry`)."""
 
 

@@ -22,20 +22,29 @@ discretization error (:func:`mirror_symmetry`): 1e-4 m g is 34 N for a tank of l
 0.1 % of the surge's peak longitudinal load on the ECP scenes."""
 
 
-def mirror_symmetry(res: Mapping[str, Any], sc: Scene) -> dict[str, Any] | None:
-    """For a vehicle run with liquid cargo whose inputs are mirror-symmetric
-    (:meth:`Scene.mirror_symmetric`), how far its liquid's lateral load strays from the exact zero:
+def mirror_symmetry(res: Mapping[str, Any], sc: Scene | SloshScene) -> dict[str, Any] | None:
+    """For a vehicle run with liquid cargo, or a slosh run, whose inputs are mirror-symmetric
+    (:meth:`Scene.mirror_symmetric`, :meth:`SloshScene.mirror_symmetric`), how far its liquid's lateral
+    load strays from the exact zero:
     ``worst_lateral_load`` (N, the largest over the cars and samples) at ``worst_time`` (s), as
     ``relative`` to the liquid's weight; ``limit`` (N, :data:`MIRROR_LOAD_LIMIT` of that weight); and
     ``lateral_valid_until``: the first sample time at which the load exceeds the limit, after which
     the run's lateral channels (liquid lateral load and centre of mass, left against right wheel
     loads) are discretization error, not physics (``docs/validation.md``, "The ECP scenes' lateral
     channels"), or ``None`` when it never does. ``None`` for other runs."""
-    if not sc.mirror_symmetric() or "fluid_force_tank" not in res or not res.get("fluid_mass"):
+    if not sc.mirror_symmetric():
         return None
+    if isinstance(sc, SloshScene):  # one tank: force_tank (n, 3)
+        if "force_tank" not in res:
+            return None
+        fy = np.abs(np.asarray(res["force_tank"], dtype=float)[:, 1])
+        weight = sc.liquid_mass() * GRAVITY
+    else:  # every car's tank: fluid_force_tank (n, cars, 3)
+        if "fluid_force_tank" not in res or not res.get("fluid_mass"):
+            return None
+        fy = np.abs(np.asarray(res["fluid_force_tank"], dtype=float)[..., 1]).max(axis=1)
+        weight = float(res["fluid_mass"]) * GRAVITY
     t = np.asarray(res["t"], dtype=float)
-    fy = np.abs(np.asarray(res["fluid_force_tank"], dtype=float)[..., 1]).max(axis=1)
-    weight = float(res["fluid_mass"]) * GRAVITY
     limit = MIRROR_LOAD_LIMIT * weight
     k = int(np.argmax(fy)) if len(fy) else 0
     over = np.flatnonzero(fy > limit)
@@ -66,9 +75,9 @@ def run_scene(
     Vehicle scenes with liquid cargo run the fluid model of :func:`railslosh.fluid_model.decide`
     (``[fluid] slosh_model``); every vehicle result carries ``fluid_model`` and ``fluid_model_reason``,
     and the largest step the run took with the rule that chose it (``step``, ``step_reason``:
-    :meth:`Scene.largest_step`), and ``mirror_symmetry`` (:func:`mirror_symmetry`: for liquid cargo
-    on mirror-symmetric inputs, the largest lateral liquid load and when the lateral channels stop
-    being trustworthy; otherwise ``None``).
+    :meth:`Scene.largest_step`). Every result carries ``mirror_symmetry`` (:func:`mirror_symmetry`:
+    for liquid on mirror-symmetric inputs, vehicle or slosh, the largest lateral liquid load and when
+    the lateral channels stop being trustworthy; otherwise ``None``).
     ``checkpoint`` keeps the run's whole state in that file every ``checkpoint_every`` recorded
     samples; ``resume_from`` continues the same scene from such a file, its results starting at the
     checkpoint (bit for bit those of the uninterrupted run; :func:`railslosh.vehicle.run`,
@@ -78,7 +87,12 @@ def run_scene(
     files = {"checkpoint": checkpoint, "checkpoint_every": checkpoint_every, "resume_from": resume_from}
     if isinstance(sc, SloshScene):
         args, kw = sc.run_args()
-        res = slosh.run(*args, **kw, progress=progress, **files)
+        try:
+            res = slosh.run(*args, **kw, progress=progress, **files)
+        except slosh.SimulationError as exc:
+            exc.results["mirror_symmetry"] = mirror_symmetry(exc.results, sc)
+            raise
+        res["mirror_symmetry"] = mirror_symmetry(res, sc)
         res["scene"] = sc
         return res
     choice = fluid_model.decide(sc)

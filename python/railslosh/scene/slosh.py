@@ -121,6 +121,30 @@ class SloshScene:
         """The :class:`railslosh.slosh.Motion` of the maneuver."""
         return motion(self.maneuver, self.t_end)
 
+    def liquid_mass(self) -> float:
+        """Mass of the liquid, kg (density times the exact volume of the mesh's region)."""
+        return self.fluid.density() * float(self.mesh().exact_volume)
+
+    def mirror_symmetric(self) -> bool:
+        """Whether the run's inputs are mirror-symmetric about the tank's x–z plane (y → −y,
+        ``docs/frames.md``): no lateral (y) acceleration, rotation (if any) about the y axis (the
+        pitch of a bump), and a tank symmetric about y = 0 (every elliptic and cylinder tank, with or
+        without bulkheads; a box whose walls are at ±y). A lane change is not (its lateral motion and
+        heading are mirrored into the other lane); bumps, pulses along x or z and samples without y
+        are. Then the liquid's lateral load is zero in an exact solution
+        (:func:`railslosh.scene.run.mirror_symmetry`), as in the vehicle runs of
+        :meth:`railslosh.scene.Scene.mirror_symmetric`."""
+        mo = self.motion()
+        lateral = any(a != 0.0 for _, a in mo.acceleration.get("y", ()))
+        ax = mo.rotation_axis
+        turning = any(a != 0.0 for _, a in mo.angular_acceleration)
+        off_pitch = ax is not None and turning and (ax[0] != 0.0 or ax[2] != 0.0)
+        if self.tank.shape == "box":
+            tank = self.tank.dims[1] == -self.tank.dims[4]
+        else:
+            tank = True
+        return not lateral and not off_pitch and tank
+
     def peak_load_factor(self) -> float:
         """Largest ``|g - a| / g`` of the maneuver (apparent gravity of the liquid, in g)."""
         mo = self.motion()
