@@ -85,36 +85,36 @@ def run_scene(
     Raises :class:`railslosh.slosh.SimulationError` when the run stops early."""
     sc = scene if isinstance(scene, Scene | SloshScene) else load_scene(scene)
     files = {"checkpoint": checkpoint, "checkpoint_every": checkpoint_every, "resume_from": resume_from}
-    if isinstance(sc, SloshScene):
-        args, kw = sc.run_args()
-        try:
-            res = slosh.run(*args, **kw, progress=progress, **files)
-        except slosh.SimulationError as exc:
-            exc.results["mirror_symmetry"] = mirror_symmetry(exc.results, sc)
-            raise
-        res["mirror_symmetry"] = mirror_symmetry(res, sc)
-        res["scene"] = sc
-        return res
-    choice = fluid_model.decide(sc)
-    step, step_reason = sc.largest_step(choice.model if sc.fluid is not None else "rigid")
-    rows = np.asarray(sc.track_rows, dtype=float)
+    extra: dict[str, Any] = {}  # what a vehicle run adds to its results, also on a failed run
+    if isinstance(sc, Scene):
+        choice = fluid_model.decide(sc)
+        step, step_reason = sc.largest_step(choice.model if sc.fluid is not None else "rigid")
+        extra = {
+            "fluid_model": choice.model,
+            "fluid_model_reason": choice.reason,
+            "step": step,
+            "step_reason": step_reason,
+        }
     try:
-        if sc.fluid is None:
-            res = vehicle.run(rows, **sc.run_kwargs(), progress=progress, **files)
-        elif choice.model == "ancf":
-            res = vehicle.run_fluid(rows, **sc.fluid_kwargs(), progress=progress, **files)
-        elif choice.model == "pendulum":
-            axis = choice.axis or "longitudinal"
-            res = vehicle.run_equivalent(rows, **sc.equivalent_kwargs(axis), progress=progress, **files)
+        if isinstance(sc, SloshScene):
+            args, kw = sc.run_args()
+            res = slosh.run(*args, **kw, progress=progress, **files)
         else:
-            res = vehicle.run(rows, **sc.rigid_kwargs(), progress=progress, **files)
+            rows = np.asarray(sc.track_rows, dtype=float)
+            if sc.fluid is None:
+                res = vehicle.run(rows, **sc.run_kwargs(), progress=progress, **files)
+            elif choice.model == "ancf":
+                res = vehicle.run_fluid(rows, **sc.fluid_kwargs(), progress=progress, **files)
+            elif choice.model == "pendulum":
+                axis = choice.axis or "longitudinal"
+                res = vehicle.run_equivalent(rows, **sc.equivalent_kwargs(axis), progress=progress, **files)
+            else:
+                res = vehicle.run(rows, **sc.rigid_kwargs(), progress=progress, **files)
     except slosh.SimulationError as exc:
-        exc.results.update(
-            fluid_model=choice.model, fluid_model_reason=choice.reason, step=step, step_reason=step_reason
-        )
+        exc.results.update(extra)
         exc.results["mirror_symmetry"] = mirror_symmetry(exc.results, sc)
         raise
-    res |= {"fluid_model": choice.model, "fluid_model_reason": choice.reason, "step": step, "step_reason": step_reason}
+    res |= extra
     res["mirror_symmetry"] = mirror_symmetry(res, sc)
     res["scene"] = sc
     return res

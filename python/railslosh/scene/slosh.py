@@ -139,11 +139,8 @@ class SloshScene:
         ax = mo.rotation_axis
         turning = any(a != 0.0 for _, a in mo.angular_acceleration)
         off_pitch = ax is not None and turning and (ax[0] != 0.0 or ax[2] != 0.0)
-        if self.tank.shape == "box":
-            tank = self.tank.dims[1] == -self.tank.dims[4]
-        else:
-            tank = True
-        return not lateral and not off_pitch and tank
+        symmetric_tank = self.tank.shape != "box" or self.tank.dims[1] == -self.tank.dims[4]
+        return not lateral and not off_pitch and symmetric_tank
 
     def peak_load_factor(self) -> float:
         """Largest ``|g - a| / g`` of the maneuver (apparent gravity of the liquid, in g)."""
