@@ -33,6 +33,7 @@ use std::time::{Duration, Instant};
 
 use rail_mbs::integrator::{Hht, MechanicalSystem, Stats};
 use rail_mbs::mbs::{Multibody, SpeedProfile};
+use rail_mbs::observe::step_to;
 use rail_mbs::track::{FOOT, Track, TrackPoint};
 use rail_mbs::vehicle::{TankCarParams, TrainScenario, build_train};
 use rail_mbs::wheel_rail::{WheelPose, WheelRailContact};
@@ -64,8 +65,9 @@ struct RunResult {
     hht: Hht<Multibody>,
 }
 
-/// The `run_train` loop (steps of at most `sc.step` landing on every recording time, the
-/// contacts evaluated once per sample as the recording does) with the integrator kept.
+/// The `run_train` loop (its step loop `step_to`: steps of at most `sc.step` landing on every
+/// recording time; the contacts evaluated once per sample as the recording does) with the
+/// integrator kept.
 fn run(sc: &TrainScenario) -> RunResult {
     let (mb, _, _) = build_train(sc).expect("train builds");
     let (q0, v0) = mb.initial_coordinates();
@@ -74,11 +76,8 @@ fn run(sc: &TrainScenario) -> RunResult {
     let n_rec = (sc.t_end / sc.record_every).round() as usize;
     for k in 0..=n_rec {
         let target = (k as f64 * sc.record_every).min(sc.t_end);
-        while hht.t() < target - 1e-12 {
-            let h = sc.step.min(target - hht.t());
-            if let Err(e) = hht.step(h) {
-                panic!("run failed at t = {}: {e}", hht.t());
-            }
+        if let Err(e) = step_to(&mut hht, target, sc.step, sc.t_end, &mut |_| true, |_, _| Ok(())) {
+            panic!("run failed at t = {}: {e}", hht.t());
         }
         let (q, v) = (hht.q().to_vec(), hht.v().to_vec());
         black_box(hht.system_mut().wheelset_reports(&q, &v).expect("contact report"));

@@ -529,12 +529,8 @@ impl<S: MechanicalSystem> Hht<S> {
                 allowed: "finite, >= current time",
             });
         }
-        let tiny = 1e-12 * (t_end.abs() + h.abs());
-        while t_end - self.t > tiny {
-            self.step_toward(t_end, h)?;
-            check(&self.system, self.state())?;
-        }
-        Ok(())
+        // the one step loop of every run kind, without an observer
+        crate::observe::step_to(self, t_end, h, t_end, &mut |_| true, |hht, _| check(&hht.system, hht.state()))
     }
 
     /// One step toward `target` of at most `h`: the step that reaches `target` (up to

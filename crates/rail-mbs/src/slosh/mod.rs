@@ -25,7 +25,7 @@ use crate::integrator::{
     Checkpoint, CheckpointFile, Explicit, ExplicitParams, Hht, HhtParams, IntegratorError, Journal, Stats,
 };
 use crate::invariants::{EnergySample, InvariantMonitor, Margins};
-use crate::observe::{Observer, Progress, RunFailure};
+use crate::observe::{Observer, RunFailure, RunStepper, step_to};
 
 /// Time series recorded by a slosh run. Loads are the force and moment the fluid exerts on
 /// the tank (through wall and bulkhead contact), moments about the tank origin.
@@ -213,6 +213,21 @@ impl SloshStepper {
                 e.advance_to(t)
             }
         }
+    }
+}
+
+/// A slosh run steps its stepper and records every step: a step toward `target` is one
+/// [`SloshStepper::advance`] of `min(h, target − t)`.
+impl RunStepper for SloshRun {
+    fn t(&self) -> f64 {
+        self.stepper.t()
+    }
+    fn stats(&self) -> &Stats {
+        self.stepper.stats()
+    }
+    fn step_toward(&mut self, target: f64, h: f64) -> Result<usize, IntegratorError> {
+        let t = self.stepper.t();
+        self.stepper.advance(h.min(target - t))
     }
 }
 
@@ -472,8 +487,9 @@ impl SloshRun {
         self.step_loop(t_end, h, observe, None)
     }
 
-    /// The step loop of every run method: step, record, append the sample to `journal` (if
-    /// any), write a due checkpoint, and ask `observe` whether to go on.
+    /// The step loop of every run method ([`step_to`], the loop of every run kind): step,
+    /// record, append the sample to `journal` (if any), write a due checkpoint, and ask
+    /// `observe` whether to go on.
     fn step_loop(
         &mut self,
         t_end: f64,
@@ -481,30 +497,14 @@ impl SloshRun {
         observe: Observer<'_>,
         mut journal: Option<&mut Journal>,
     ) -> Result<(), Box<SloshFailure>> {
-        let fail = |run: &Self, error| Box::new(SloshFailure { error, record: run.record.clone() });
-        while t_end - self.stepper.t() > 1e-12 * (1.0 + t_end.abs()) {
-            let h_step = h.min(t_end - self.stepper.t());
-            match self.stepper.advance(h_step) {
-                Ok(iterations) => self.record_state(iterations).map_err(|e| fail(self, e))?,
-                Err(error) => return Err(fail(self, error)),
-            }
+        step_to(self, t_end, h, t_end, observe, |run, iterations| {
+            run.record_state(iterations)?;
             if let Some(j) = journal.as_deref_mut() {
-                j.append(&self.record.row(self.record.t.len() - 1)).map_err(|e| fail(self, e))?;
+                j.append(&run.record.row(run.record.t.len() - 1))?;
             }
-            self.checkpoint_if_due().map_err(|e| fail(self, e))?;
-            let s = self.stepper.stats();
-            let progress = Progress {
-                t: self.stepper.t(),
-                t_end,
-                steps: s.steps,
-                newton_iterations: s.newton_iterations,
-                rejected_steps: s.rejected_steps,
-            };
-            if !observe(&progress) {
-                return Err(fail(self, crate::vehicle::stopped_by_observer(self.stepper.t())));
-            }
-        }
-        Ok(())
+            run.checkpoint_if_due()
+        })
+        .map_err(|error| Box::new(SloshFailure { error, record: self.record.clone() }))
     }
 
     /// [`SloshRun::run_to_observed`] that also appends every recorded sample (and any

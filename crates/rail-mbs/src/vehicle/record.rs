@@ -7,10 +7,11 @@
 
 use nalgebra::Vector3;
 
-use super::run::{Observer, Progress, TrainScenario, stopped_by_observer};
+use super::run::{Observer, TrainScenario};
 use super::tank_car::{CarBodies, wheel_loads};
 use crate::integrator::{Hht, IntegratorError};
 use crate::mbs::Multibody;
+use crate::observe::step_to;
 use crate::track::Track;
 
 pub(crate) use super::load_filter::HatMean;
@@ -285,22 +286,17 @@ pub(crate) fn step_and_record<S: crate::integrator::MechanicalSystem>(
     'samples: for k in k0..=n_rec {
         let t_prev = if k == 0 { 0.0 } else { ((k - 1) as f64 * sc.record_every).min(sc.t_end) };
         let target = (k as f64 * sc.record_every).min(sc.t_end);
-        while hht.t() < target - 1e-12 {
-            let stepped = hht.step_toward(target, sc.step).map(|_| ()).and_then(|_| {
-                if filtered {
-                    record(hht, RecordEvent::Loads(&mut buf))?;
-                    hat.step(t_prev, target, hht.t(), buf.clone());
-                }
-                Ok(())
-            });
-            if let Err(e) = stepped {
-                result = Err(e);
-                break 'samples;
+        // the filtered load channels take every step
+        let stepped = step_to(hht, target, sc.step, sc.t_end, &mut *observe, |hht, _| {
+            if filtered {
+                record(hht, RecordEvent::Loads(&mut buf))?;
+                hat.step(t_prev, target, hht.t(), buf.clone());
             }
-            if !observe(&Progress::of(hht, sc.t_end)) {
-                result = Err(stopped_by_observer(hht.t()));
-                break 'samples;
-            }
+            Ok(())
+        });
+        if let Err(e) = stepped {
+            result = Err(e);
+            break 'samples;
         }
         if let Err(e) = record(hht, RecordEvent::Sample(k)) {
             result = Err(e);
