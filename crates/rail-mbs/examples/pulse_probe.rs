@@ -3,7 +3,8 @@
 //! args: NX NY NZ H_MAX K_FACTOR WALL_DAMPING_FACTOR T_END OUT.csv
 //! (K_FACTOR scales the bulk penalty k_IC, its damping following the default rule;
 //! WALL_DAMPING_FACTOR scales the wall contact damping, 30 in the validation case;
-//! environment ADH: the wall adhesion, in units of ρ g H).
+//! environment ADH: the wall adhesion, in units of ρ g H; INC, GROW, EASY, DEC: the adaptive
+//! step controller's settings).
 //! Writes t, F_y (N), Newton iterations, largest penetration (m) per step.
 use std::io::Write;
 
@@ -56,7 +57,17 @@ fn main() {
     let mut motion = PrescribedMotion::at_rest([0.0; 3]);
     motion.translation[1] = PiecewiseAcceleration::pulse(0.3 * G, 0.1, 0.6, 0.02).unwrap();
     let sys = SloshSystem::new(body, contact, motion, [0.0, 0.0, -G], SloshFrame::Inertial).unwrap();
-    let mut run = SloshRun::new(sys, 0.0, slosh_params()).unwrap();
+    // environment INC, GROW, EASY, DEC: the adaptive controller's increase, grow_after,
+    // easy_iterations and decrease (default: `slosh_params`)
+    let mut params = slosh_params();
+    if let rail_mbs::integrator::StepControl::Adaptive(p) = &mut params.step_control {
+        let env = |k: &str| std::env::var(k).ok().map(|v| v.parse::<f64>().unwrap());
+        p.increase = env("INC").unwrap_or(p.increase);
+        p.decrease = env("DEC").unwrap_or(p.decrease);
+        p.grow_after = env("GROW").map_or(p.grow_after, |x| x as usize);
+        p.easy_iterations = env("EASY").map_or(p.easy_iterations, |x| x as usize);
+    }
+    let mut run = SloshRun::new(sys, 0.0, params).unwrap();
     let t0 = std::time::Instant::now();
     if let Ok(ev) = std::env::var("EVENT") {
         // per-point F_y around an event: EVENT=ta,tb
@@ -130,9 +141,16 @@ fn main() {
         )
         .unwrap();
     }
+    let st = run.stats();
     eprintln!(
-        "{counts:?} h<={h} k x{kfac} wall damping x{dfac}: {} steps, {:.1} s",
+        "{counts:?} h<={h} k x{kfac} wall damping x{dfac}: {} steps, {:.1} s; rejected {}, Newton {}, \
+         Jacobians {}, factorizations {}, residuals {}",
         r.t.len() - 1,
-        t0.elapsed().as_secs_f64()
+        t0.elapsed().as_secs_f64(),
+        st.rejected_steps,
+        st.newton_iterations,
+        st.jacobian_evaluations,
+        st.factorizations,
+        st.residual_evaluations
     );
 }
