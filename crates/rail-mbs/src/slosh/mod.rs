@@ -217,7 +217,7 @@ impl SloshStepper {
 }
 
 /// A slosh run steps its stepper and records every step: a step toward `target` is one
-/// [`SloshStepper::advance`] of `min(h, target − t)`.
+/// `SloshStepper::advance` of `min(h, target − t)`.
 impl RunStepper for SloshRun {
     fn t(&self) -> f64 {
         self.stepper.t()
