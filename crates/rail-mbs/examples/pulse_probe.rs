@@ -144,13 +144,16 @@ fn main() {
     let st = run.stats();
     eprintln!(
         "{counts:?} h<={h} k x{kfac} wall damping x{dfac}: {} steps, {:.1} s; rejected {}, Newton {}, \
-         Jacobians {}, factorizations {}, residuals {}",
+         Jacobians {}, factorizations {}, residuals {}; assembly {:.1} s, factorization {:.1} s, solves {:.1} s",
         r.t.len() - 1,
         t0.elapsed().as_secs_f64(),
         st.rejected_steps,
         st.newton_iterations,
         st.jacobian_evaluations,
         st.factorizations,
-        st.residual_evaluations
+        st.residual_evaluations,
+        st.time_assembly.as_secs_f64(),
+        st.time_factorization.as_secs_f64(),
+        st.time_solve.as_secs_f64()
     );
 }

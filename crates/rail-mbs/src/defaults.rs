@@ -12,19 +12,32 @@ use crate::integrator::{AdaptiveParams, HhtParams, StepControl};
 use crate::mbs::Table;
 use crate::vehicle::{BrakeScope, TankCarParams};
 
+/// Easy steps in a row before a slosh run doubles its step again (issue 17). After 5 (the
+/// integrator's default) the step just grown mostly failed again: on the rectangular tank's
+/// 0.3 g pulse (4×8×3, 2 s) 579 failed attempts and 1 320 factorizations; after 20, 347 and 686,
+/// 1.17× faster and 3× closer to the 1 ms-capped run (docs/benchmarks.md, "Growing the step less
+/// often"); after 50 the extra steps cost more than the factorizations save.
+pub const SLOSH_GROW_AFTER: usize = 20;
+
 /// HHT settings of slosh runs: α = −0.3 (numerical damping of the penalty and contact
 /// modes), tolerances scaled to accelerations of order g, adaptive steps (h is the
-/// largest step; it is halved where Newton fails or an element would invert, and grows
-/// back after 5 steps that converged in fewer than 5 iterations), and the Jacobian reused
-/// until the Newton contraction rate exceeds 0.5 (measured fastest on the tank-car
-/// benchmark: 10.0 s vs 17.5 s wall for 1 s simulated, `cargo bench -p rail-mbs --bench slosh`).
+/// largest step; it is halved where Newton fails or an element would invert, and doubles
+/// again after [`SLOSH_GROW_AFTER`] steps in a row that converged in fewer than 5 iterations),
+/// and the Jacobian reused until the Newton contraction rate exceeds 0.5 (measured fastest on
+/// the tank-car benchmark: 10.0 s vs 17.5 s wall for 1 s simulated, `cargo bench -p rail-mbs
+/// --bench slosh`).
 pub fn slosh_params() -> HhtParams {
     HhtParams {
         alpha: -0.3,
         abs_tol_acc: 1e-3,
         max_iterations: 10,
         refresh_rate: 0.5,
-        step_control: StepControl::Adaptive(AdaptiveParams { h_min: 1e-6, easy_iterations: 5, ..Default::default() }),
+        step_control: StepControl::Adaptive(AdaptiveParams {
+            h_min: 1e-6,
+            easy_iterations: 5,
+            grow_after: SLOSH_GROW_AFTER,
+            ..Default::default()
+        }),
         ..Default::default()
     }
 }

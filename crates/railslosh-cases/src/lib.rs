@@ -36,9 +36,10 @@ pub use record::Record;
 
 /// Wall damping ratio of the shipped scenes (critical: the crude-oil car scenes and the lane
 /// changes, docs/validation.md "Wall damping"), used by the cases that measure what the scenes
-/// run: `slosh-load-convergence`, `bulkhead-longitudinal` and `coupler-force-convergence` (the
-/// other car studies keep the library's walls: with these, the quick form of `ecp-braking-oils`
-/// loses its oil orderings, docs/validation.md "Crude-oil studies").
+/// run: `slosh-load-convergence`, `bulkhead-longitudinal`, `tank-frame-equivalence` and
+/// `coupler-force-convergence` (the other car studies keep the library's walls: with these, the
+/// quick form of `ecp-braking-oils` loses its oil orderings, docs/validation.md "Crude-oil
+/// studies").
 pub const SCENE_WALL_DAMPING: f64 = 1.0;
 /// Wall adhesion (suction, × ρ g H) of the shipped crude-oil scenes (docs/validation.md "Wall
 /// peeling"), used by the same cases as [`SCENE_WALL_DAMPING`].
