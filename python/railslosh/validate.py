@@ -54,15 +54,16 @@ _DESCRIPTIONS = {
     "first-mode frequency vs analytic 1.436 Hz",
     "slosh-cylinder-half": "half-full horizontal cylinder: stable rest state, transverse mode lambda vs 1.3557 "
     "(linear modes; full form also the pulse response), longitudinal mode vs the rectangular-tank formula",
-    "slosh-viscous-decay": "free sloshing decays faster from water through the crude oils of seed 000 Table 2; "
-    "heavy crude settles within one period",
+    "slosh-viscous-decay": "free sloshing decays faster from water through the crude oils of seed 000 Table 2 "
+    "(water and light crude ordered by viscous power per kinetic energy); heavy crude settles within one period",
     "bulkhead-longitudinal": "three-compartment tank car has a lower peak longitudinal load than the open tank "
     "under the same braking pulse",
     "tank-frame-equivalence": "same manoeuvre as tank-frame pseudo-forces and as prescribed inertial motion: "
     "same loads within 1 %",
     "slosh-linear-potential-flow": "seed 003 rectangular tank, 0.03 g lateral pulse (linear regime): lateral load "
     "history vs the 50-mode linear potential-flow solution, RMS difference over 0.5-4 s <= 10 % of its peak; "
-    "first-mode frequency from zero crossings vs 1.436 Hz",
+    "first-mode frequency from zero crossings vs 1.436 Hz; viscous power per kinetic energy vs the modes' "
+    "8 nu k^2 (Lamb)",
     "slosh-load-convergence": "seed 003 rectangular tank, 0.3 g lateral pulse: peak lateral load after the pulse and "
     "f1 from zero crossings of the raw load change <= 5 % between the two finest of three meshes and two step sizes; "
     "raw zero-crossing frequency within 3 % of the spectral peak (no chatter)",

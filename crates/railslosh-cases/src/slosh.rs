@@ -5,10 +5,10 @@
 //! | `hydrostatic-cylinder` | a half-full tank car at rest settles: vertical load = m g, no horizontal load or moment, volume and centroid conserved |
 //! | `slosh-rect-tank` | seed 003 appendix C §4.1: 0.416 × 0.324 m tank, 0.132 m water, lateral 0.3 g pulse for 0.5 s; first-mode frequency vs the analytic 1.436 Hz |
 //! | `slosh-cylinder-half` | half-full horizontal cylinder: the rest state of the cross-section model is stable; its first transverse mode λ = ω²R/g vs 1.3557 (Budiansky; McIver 1989), from the linear modes and (full form) from the time response to a lateral pulse; first longitudinal mode vs the rectangular-tank formula with the equivalent depth πR/4 |
-//! | `slosh-viscous-decay` | free sloshing after a pulse decays faster from water through the light, medium and heavy crudes of seed 000 Table 2; the heavy crude settles within one period |
+//! | `slosh-viscous-decay` | free sloshing after a pulse decays faster from water through the light, medium and heavy crudes of seed 000 Table 2 (water and the light crude, both Newtonian, ordered by their viscous power per kinetic energy); the heavy crude settles within one period |
 //! | `bulkhead-longitudinal` | under the same braking pulse, a tank car divided into three compartments by two bulkheads has a lower peak longitudinal load than the open tank |
 //! | `tank-frame-equivalence` | the same motion given as tank-frame pseudo-forces (seed 003 eq. 7.40) and as prescribed inertial motion gives the same loads |
-//! | `slosh-linear-potential-flow` | seed 003's rectangular tank under a 0.03 g lateral pulse (linear regime): the lateral load history vs the 50-mode linear potential-flow solution ([`rail_mbs::slosh::linear_theory`]), RMS difference over 0.5–4 s ≤ 10 % of its peak; first-mode frequency from zero crossings vs 1.436 Hz |
+//! | `slosh-linear-potential-flow` | seed 003's rectangular tank under a 0.03 g lateral pulse (linear regime): the lateral load history vs the 50-mode linear potential-flow solution ([`rail_mbs::slosh::linear_theory`]), RMS difference over 0.5–4 s ≤ 10 % of its peak; first-mode frequency from zero crossings vs 1.436 Hz; the viscous power per kinetic energy vs the same modes' Lamb dissipation 8νk_n² |
 //! | `slosh-load-convergence` | the same tank under a 0.3 g lateral pulse (issue 16 §3): the peak lateral load after the pulse and f₁ from the zero crossings of the raw load change by ≤ 5 % between the two finest of three meshes and between two step sizes; on the finest mesh the raw zero-crossing frequency is within 3 % of the spectral peak (no chatter) |
 //! | `rest-state` | issue 16 §6: the liquid at rest on the default and shipped meshes, with the recommended shear stabilization, is a stable equilibrium: the smallest eigenvalue λ = ω²H/g of the linearization about the settled state is ≥ 0 (quick: the SwRI scenes' 1×2×2 and the car scenes' 2×2×2; full: also the rectangular tank's 4×8×3 and 3×6×2, the SwRI 2×4×2 default slosh-scene mesh and 2×4×4, the car's 6×4×2) |
 //!
@@ -23,6 +23,7 @@ use ancf_core::error::{AncfError, Result};
 use ancf_core::mesh::{CylinderTankSpec, FluidMesh, box_mesh, cylinder_tank, cylinder_tank_compartments};
 use ancf_core::tank::{Bulkhead, TankGeometry, TankShape};
 
+use rail_mbs::integrator::IntegratorError;
 use rail_mbs::slosh::analysis::dominant_frequency;
 use rail_mbs::slosh::linear_theory::rect_tank_frequency;
 use rail_mbs::slosh::{
@@ -623,6 +624,48 @@ fn amplitude(t: &[f64], x: &[f64], ta: f64, tb: f64) -> f64 {
     sel.iter().map(|v| (v - mean).abs()).fold(0.0, f64::max)
 }
 
+/// Viscous dissipation of the liquid relative to its kinetic energy, ∫P_v dt / ∫T dt over
+/// [`t_a`, `t_end`] (1/s), from every accepted step of the run as it goes on to `t_end` with
+/// steps ≤ `h` (the steps of [`SloshRun::run_to`]): P_v = u·f_v the power of the deviatoric
+/// viscous stress alone (the body's fluid without its bulk penalty, bulk viscosity and
+/// stabilizations) and T = ½ uᵀMu, u the velocity relative to the (translating) tank. For
+/// linear sloshing in a tank with free-slip walls P_v = 8νk_n² T for each mode n
+/// ([`rail_mbs::slosh::linear_theory`], "Viscous dissipation"; Lamb §348).
+fn viscous_to_kinetic(run: &mut SloshRun, t_a: f64, t_end: f64, h: f64) -> Result<f64> {
+    let fail = |e: String| AncfError::NonFinite { what: e, element: 0 };
+    let mut viscous = run.stepper.system().body.clone();
+    viscous.fluid.bulk_penalty = 0.0;
+    viscous.fluid.bulk_damping = 0.0;
+    viscous.fluid.shear_stabilization = 0.0;
+    viscous.fluid.hourglass_stabilization = 0.0;
+    let mut f = vec![0.0; viscous.n_coords()];
+    let mut samples: Vec<[f64; 3]> = Vec::new(); // t, P_v, T
+    run.run_to_inspected(t_end, h, &mut |run: &SloshRun| {
+        let t = run.stepper.t();
+        if t < t_a - 1e-12 {
+            return Ok(());
+        }
+        let sys = run.stepper.system();
+        let tank = sys.motion.state(t).kinematics.velocity;
+        let mut u = run.stepper.v().to_vec();
+        for (k, x) in u.iter_mut().enumerate() {
+            // the position coordinates of node j are 12 j .. 12 j + 2; a translation leaves
+            // the gradients alone
+            if k % 12 < 3 {
+                *x -= tank[k % 12];
+            }
+        }
+        viscous
+            .internal_forces(run.stepper.q(), &u, &mut f)
+            .map_err(|e| IntegratorError::InvalidSystem { what: e.to_string() })?;
+        samples.push([t, u.iter().zip(&f).map(|(a, b)| a * b).sum::<f64>(), sys.body.kinetic_energy(&u)]);
+        Ok(())
+    })
+    .map_err(|e| fail(e.to_string()))?;
+    let integral = |k: usize| samples.windows(2).map(|w| 0.5 * (w[0][k] + w[1][k]) * (w[1][0] - w[0][0])).sum::<f64>();
+    Ok(integral(1).abs() / integral(2))
+}
+
 fn slosh_viscous_decay(quick: bool) -> Result<Vec<Record>> {
     let c = "slosh-viscous-decay";
     let counts = if quick { [2, 4, 2] } else { [3, 6, 2] };
@@ -649,7 +692,24 @@ fn slosh_viscous_decay(quick: bool) -> Result<Vec<Record>> {
         )?;
         let mut motion = PrescribedMotion::at_rest([0.0; 3]);
         motion.translation[1] = PiecewiseAcceleration::pulse(0.3 * G, 0.0, 0.5, 0.01)?;
-        let (rec, mass) = run(mesh, fluid, geo, d, motion, SloshFrame::Inertial, t_end, 0.004)?;
+        // Newtonian liquids (the light crude's Oldroyd law without yield stress or elasticity is
+        // one): their ordering is checked on the viscous dissipation (below)
+        let newtonian = match rh {
+            Rheology::Newtonian { .. } => true,
+            Rheology::Oldroyd { yield_stress, elastic_modulus, .. } => {
+                *yield_stress == 0.0 && elastic_modulus.is_none()
+            }
+            _ => false,
+        };
+        let law = WallContactLaw::default_for(fluid.density, G, d);
+        let body = FluidBody::new(mesh, fluid, QuadratureOptions::default())?;
+        let contact = WallContact::new(&body, geo, law)?;
+        let mass = body.total_mass();
+        let sys = SloshSystem::new(body, contact, motion, [0.0, 0.0, -G], SloshFrame::Inertial)?;
+        let mut r = SloshRun::new(sys, 0.0, slosh_params())
+            .map_err(|e| AncfError::NonFinite { what: e.to_string(), element: 0 })?;
+        let dissipation = viscous_to_kinetic(&mut r, t1 + period, t_end, 0.004)?;
+        let rec = r.record;
         let fy: Vec<f64> = rec.force_tank.iter().map(|f| f[1]).collect();
         let a2 = amplitude(&rec.t, &fy, t1 + period, t1 + 2.0 * period);
         let a3 = amplitude(&rec.t, &fy, t1 + 2.0 * period, t1 + 3.0 * period);
@@ -659,7 +719,7 @@ fn slosh_viscous_decay(quick: bool) -> Result<Vec<Record>> {
         // already settled in the first period.
         let pulse_load = mass * 0.3 * G;
         let rate = (pulse_load / a3.max(1e-6 * pulse_load)).ln() / (2.5 * period);
-        rates.push((name.to_string(), rate));
+        rates.push((name.to_string(), rate, newtonian.then_some(dissipation)));
         out.push(Record::at_most(
             c,
             format!("{name}: residual load amplitude 1-2 periods after the pulse / pulse load (m 0.3 g); decay rate {rate:.3} 1/s"),
@@ -668,13 +728,34 @@ fn slosh_viscous_decay(quick: bool) -> Result<Vec<Record>> {
         ));
     }
     for w in rates.windows(2) {
-        out.push(Record {
-            case: c.into(),
-            quantity: format!("decay rate grows: {} ({:.3} 1/s) > {} (reference)", w[1].0, w[1].1, w[0].0),
-            measured: w[1].1,
-            reference: w[0].1,
-            tolerance: 0.0,
-            passed: w[1].1 > w[0].1 || (w[1].1.is_infinite() && w[1].1 > 0.0),
+        let (a, b) = (&w[0], &w[1]);
+        out.push(match (a.2, b.2) {
+            // Two Newtonian liquids (water, light crude): on frictionless walls their viscous
+            // decay differs by 2Δν k² ≈ 1e-3 1/s (Lamb), twenty times below what the walls'
+            // contact damping and each run's step sequence put between their residual
+            // amplitudes; the viscous power per kinetic energy of the sloshing liquid decides
+            // it (docs/validation.md, "The slosh step controller").
+            (Some(da), Some(db)) => Record {
+                case: c.into(),
+                quantity: format!(
+                    "viscosity orders the dissipation: viscous power / kinetic energy after the pulse, {} ({db:.3e} \
+                     1/s) > {} (reference; residual-amplitude decay rates {:.3} and {:.3} 1/s, below the contact and \
+                     integrator noise)",
+                    b.0, a.0, b.1, a.1
+                ),
+                measured: db,
+                reference: da,
+                tolerance: 0.0,
+                passed: db > da,
+            },
+            _ => Record {
+                case: c.into(),
+                quantity: format!("decay rate grows: {} ({:.3} 1/s) > {} (reference)", b.0, b.1, a.0),
+                measured: b.1,
+                reference: a.1,
+                tolerance: 0.0,
+                passed: b.1 > a.1 || (b.1.is_infinite() && b.1 > 0.0),
+            },
         });
     }
     Ok(out)
@@ -823,7 +904,19 @@ fn slosh_linear_potential_flow(quick: bool) -> Result<Vec<Record>> {
     law.damping *= wall_factor.powf(1.5);
     law.points_per_edge = 4;
     let quad = QuadratureOptions { penalty: 4, ..QuadratureOptions::default() };
-    let (rec, mass) = run_with(mesh, fluid, geo, law, quad, motion, SloshFrame::Inertial, t_b, h)?;
+    // the run, with the viscous dissipation from every step after t_a
+    let nu = match fluid.rheology {
+        Rheology::Newtonian { viscosity } => viscosity / fluid.density,
+        _ => unreachable!("rect_setup's water is Newtonian"),
+    };
+    let body = FluidBody::new(mesh, fluid, quad)?;
+    let contact = WallContact::new(&body, geo, law)?;
+    let mass = body.total_mass();
+    let sys = SloshSystem::new(body, contact, motion, [0.0, 0.0, -G], SloshFrame::Inertial)?;
+    let mut run = SloshRun::new(sys, 0.0, slosh_params())
+        .map_err(|e| AncfError::NonFinite { what: e.to_string(), element: 0 })?;
+    let viscous = viscous_to_kinetic(&mut run, t_a, t_b, h)?;
+    let rec = run.record;
     let modes = rail_mbs::slosh::linear_theory::RectangularTankModes::new(ly, d, mass, G, 50)?;
     let n_grid = ((t_b - t_a) / 1e-3).round() as usize;
     let grid: Vec<f64> = (0..=n_grid).map(|i| t_a + (t_b - t_a) * i as f64 / n_grid as f64).collect();
@@ -836,6 +929,11 @@ fn slosh_linear_potential_flow(quick: bool) -> Result<Vec<Record>> {
     let f1 = zero_crossing_frequency(&rec.t, &fy, t_a, t_b);
     let f1_modal = zero_crossing_frequency(&grid, &f_ref, t_a, t_b);
     let f1_ref = modes.frequencies()[0];
+    let lamb = modes.viscous_dissipation_rate(&samples, &grid, nu)?;
+    // The dissipation is quadratic in the velocity gradients, which the quick mesh (three
+    // elements across half the first mode's wavelength) resolves less well than the loads:
+    // measured −12 % on 2×6×2, −0.3 % on 2×8×3 (docs/validation.md).
+    let viscous_tolerance = if quick { 0.15 } else { 0.05 };
     let tag = format!(
         "0.03 g lateral pulse 0.1-0.5 s (20 ms ramps), mesh {counts:?}, h <= {h} s, 4^3 penalty points, \
          4x4 contact points, walls 100x stiffer"
@@ -863,6 +961,19 @@ fn slosh_linear_potential_flow(quick: bool) -> Result<Vec<Record>> {
             f1,
             f1_ref,
             0.01 * f1_ref,
+        ),
+        // Lamb's dissipation of the same modal response (linear_theory, "Viscous dissipation")
+        Record::abs(
+            c,
+            format!(
+                "viscous power / kinetic energy relative to the tank over {t_a}-{t_b} s (1/s) vs the 50-mode \
+                 potential flow's sum of 8 nu k_n^2 T_n / T (Lamb; 8 nu k_1^2 = {:.4e} 1/s), tolerance {:.0} %, {tag}",
+                8.0 * nu * (std::f64::consts::PI / ly).powi(2),
+                100.0 * viscous_tolerance
+            ),
+            viscous,
+            lamb,
+            viscous_tolerance * lamb,
         ),
     ])
 }

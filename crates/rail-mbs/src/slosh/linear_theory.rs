@@ -65,6 +65,22 @@
 //! acting between the mass and the tank, so that F = −(m − Σ m_n) a + Σ m_n (ω_n² x_n +
 //! 2ζω_n ẋ_n). The textbook (potential-flow) reference is undamped, ζ = 0.
 //!
+//! # Viscous dissipation (the reference of the viscous law in a sloshing flow)
+//!
+//! The relative potential of mode n, A_n cos(k_n s) cosh(k_n(z + h))/cosh(k_n h), carries
+//! the kinetic energy ½ρ∫|∇Φ_n|² = ½ m_n ẋ_n² (per the substitutions above: with
+//! A_n = η̇_n/(k_n tanh k_n h) and η_n = −β_n x_n the ratio of the two is L²k_n²/((2n−1)²π²) = 1),
+//! so the oscillators' energies are the liquid's. A Newtonian liquid of kinematic viscosity ν
+//! in this potential flow dissipates 2μ∫Σ_ij (∂²Φ/∂x_i∂x_j)² dV (Lamb, *Hydrodynamics*, §348;
+//! with free-slip walls there is no boundary layer). Averaged over s, Σ_ij Φ_ij² of mode n is
+//! k_n⁴ A_n² cosh(2k_n(z+h))/cosh²(k_n h) and |∇Φ_n|² is half of k_n² A_n² cosh(2k_n(z+h))/
+//! cosh²(k_n h), so the mode dissipates **8νk_n² times its kinetic energy at every instant**,
+//! whatever the depth (the modes are orthogonal, so the sum is the sum over modes); the energy
+//! of a free standing wave decays at 4νk_n², its amplitude at 2νk_n².
+//! [`RectangularTankModes::viscous_dissipation_rate`] gives the kinetic-energy-weighted mean of
+//! 8νk_n² over a response: the ratio of viscous power to relative kinetic energy a resolved
+//! viscous law must reproduce.
+//!
 //! # Integration
 //!
 //! The acceleration is piecewise linear in time (samples (t_i, a_i) with the convention of
@@ -161,6 +177,40 @@ impl RectangularTankModes {
     /// Fixed mass m₀ = m − Σ m_n that moves with the tank (kg).
     pub fn fixed_mass(&self) -> f64 {
         self.mass - self.modal_mass.iter().sum::<f64>()
+    }
+
+    /// Viscous dissipation of the potential flow relative to its kinetic energy (1/s), over the
+    /// response to `accel` sampled at `times` (as [`Self::force_history`]): ∫Σ_n 8νk_n² T_n dt /
+    /// ∫Σ_n T_n dt with T_n = ½ m_n ẋ_n² the kinetic energy of mode n relative to the tank and
+    /// ν = `kinematic_viscosity` (module docs, "Viscous dissipation"); trapezoidal in time.
+    pub fn viscous_dissipation_rate(
+        &self,
+        accel: &[(f64, f64)],
+        times: &[f64],
+        kinematic_viscosity: f64,
+    ) -> Result<f64> {
+        if !(kinematic_viscosity.is_finite() && kinematic_viscosity >= 0.0) {
+            return Err(invalid("kinematic_viscosity", kinematic_viscosity, "a number >= 0"));
+        }
+        let states = self.response(accel, times)?;
+        let (mut dissipation, mut kinetic) = (Vec::with_capacity(times.len()), Vec::with_capacity(times.len()));
+        for st in &states {
+            let (mut d, mut t) = (0.0, 0.0);
+            for (n, ([_, v], &mn)) in st.iter().zip(&self.modal_mass).enumerate() {
+                let k = (2 * n + 1) as f64 * std::f64::consts::PI / self.length;
+                let energy = 0.5 * mn * v * v;
+                d += 8.0 * kinematic_viscosity * k * k * energy;
+                t += energy;
+            }
+            dissipation.push(d);
+            kinetic.push(t);
+        }
+        let trapezoid = |y: &[f64]| y.windows(2).map(|w| 0.5 * (w[0] + w[1])).sum::<f64>();
+        let kinetic = trapezoid(&kinetic);
+        if kinetic <= 0.0 {
+            return Err(invalid("accel", "no sloshing over times", "an excitation that moves the liquid"));
+        }
+        Ok(trapezoid(&dissipation) / kinetic)
     }
 
     /// Horizontal force of the liquid on the tank (N, along the excitation; the sign
@@ -288,6 +338,27 @@ mod tests {
 
     fn peak(x: &[f64]) -> f64 {
         x.iter().fold(0.0, |m, v| m.max(v.abs()))
+    }
+
+    #[test]
+    fn viscous_dissipation_of_a_standing_wave_is_8_nu_k_squared_times_its_kinetic_energy() {
+        let nu = 1e-6;
+        let k1 = std::f64::consts::PI / L;
+        let pulse = [(0.1, 0.0), (0.12, 0.3), (0.48, 0.3), (0.5, 0.0)];
+        let times: Vec<f64> = (0..=3500).map(|i| 0.5 + 1e-3 * i as f64).collect();
+        // one mode: exactly 8 ν k₁²
+        let one = RectangularTankModes::new(L, H, M, G, 1).unwrap();
+        let r1 = one.viscous_dissipation_rate(&pulse, &times, nu).unwrap();
+        assert!((r1 / (8.0 * nu * k1 * k1) - 1.0).abs() < 1e-12, "{r1}");
+        // fifty: the higher modes (k_n = (2n−1) k₁) add a little
+        let r = seed_tank().viscous_dissipation_rate(&pulse, &times, nu).unwrap();
+        let excess = r / (8.0 * nu * k1 * k1) - 1.0;
+        assert!(excess > 0.0 && excess < 0.2, "{excess}");
+        // linear in ν; no motion, no ratio
+        let r2 = seed_tank().viscous_dissipation_rate(&pulse, &times, 2.0 * nu).unwrap();
+        assert!((r2 / r - 2.0).abs() < 1e-12);
+        assert!(seed_tank().viscous_dissipation_rate(&[(0.0, 0.0), (1.0, 0.0)], &times, nu).is_err());
+        assert!(seed_tank().viscous_dissipation_rate(&pulse, &times, -1.0).is_err());
     }
 
     #[test]

@@ -261,6 +261,10 @@ impl StepperChoice {
 /// "Explicit against implicit"): Newton iterations × (force + Jacobian share + sparse solve).
 pub const IMPLICIT_STEP_COST: f64 = 25.0;
 
+/// Called with the run after every accepted, recorded step ([`SloshRun::run_to_inspected`]);
+/// an error stops the run.
+pub type Inspector<'a> = &'a mut dyn FnMut(&SloshRun) -> Result<(), IntegratorError>;
+
 /// A slosh run: the stepper, its system and the record.
 pub struct SloshRun {
     /// The time stepper (owns the system).
@@ -484,25 +488,37 @@ impl SloshRun {
     /// [`SloshRun::run_to`] calling `observe` after every accepted step; the run stops
     /// (with [`crate::vehicle::stopped_by_observer`]) when it returns `false`.
     pub fn run_to_observed(&mut self, t_end: f64, h: f64, observe: Observer<'_>) -> Result<(), Box<SloshFailure>> {
-        self.step_loop(t_end, h, observe, None)
+        self.step_loop(t_end, h, observe, None, None)
+    }
+
+    /// [`SloshRun::run_to`] handing the run to `inspect` after every accepted step, once the
+    /// step is recorded (e.g. to evaluate a quantity of the state that the record does not
+    /// carry); an error from `inspect` stops the run. The steps are those of `run_to`.
+    pub fn run_to_inspected(&mut self, t_end: f64, h: f64, inspect: Inspector<'_>) -> Result<(), Box<SloshFailure>> {
+        self.step_loop(t_end, h, &mut |_| true, None, Some(inspect))
     }
 
     /// The step loop of every run method ([`step_to`], the loop of every run kind): step,
-    /// record, append the sample to `journal` (if any), write a due checkpoint, and ask
-    /// `observe` whether to go on.
+    /// record, append the sample to `journal` (if any), write a due checkpoint, hand the run
+    /// to `inspect` (if any), and ask `observe` whether to go on.
     fn step_loop(
         &mut self,
         t_end: f64,
         h: f64,
         observe: Observer<'_>,
         mut journal: Option<&mut Journal>,
+        mut inspect: Option<Inspector<'_>>,
     ) -> Result<(), Box<SloshFailure>> {
         step_to(self, t_end, h, t_end, observe, |run, iterations| {
             run.record_state(iterations)?;
             if let Some(j) = journal.as_deref_mut() {
                 j.append(&run.record.row(run.record.t.len() - 1))?;
             }
-            run.checkpoint_if_due()
+            run.checkpoint_if_due()?;
+            match inspect.as_deref_mut() {
+                Some(f) => f(run),
+                None => Ok(()),
+            }
         })
         .map_err(|error| Box::new(SloshFailure { error, record: self.record.clone() }))
     }
@@ -523,7 +539,7 @@ impl SloshRun {
         while journal.rows() < self.record.t.len() {
             journal.append(&self.record.row(journal.rows())).map_err(|e| fail(self, e))?;
         }
-        self.step_loop(t_end, h, observe, Some(&mut *journal))?;
+        self.step_loop(t_end, h, observe, Some(&mut *journal), None)?;
         journal.flush().map_err(|e| fail(self, e))
     }
 
