@@ -28,6 +28,20 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
+/// Median wall times (ms) of `stage(0)` (the factorization) and `stage(1)` (a solve), run
+/// alternately `repeats` times.
+fn medians(repeats: usize, mut stage: impl FnMut(usize)) -> [f64; 2] {
+    let mut times = [Vec::new(), Vec::new()];
+    for _ in 0..repeats {
+        for (k, t) in times.iter_mut().enumerate() {
+            let tic = Instant::now();
+            stage(k);
+            t.push(1e3 * tic.elapsed().as_secs_f64());
+        }
+    }
+    times.map(median)
+}
+
 fn main() {
     let a: Vec<usize> = std::env::args().skip(1).map(|s| s.parse().unwrap()).collect();
     let counts = [a.first().copied().unwrap_or(4), a.get(1).copied().unwrap_or(8), a.get(2).copied().unwrap_or(3)];
@@ -60,28 +74,15 @@ fn main() {
             .or(lu_symbolic.solve_in_place_scratch::<f64>(1, par)),
     );
     let mut x = vec![1.0; n];
-    let (mut lu_factor, mut lu_solve) = (Vec::new(), Vec::new());
-    for _ in 0..repeats {
-        let t = Instant::now();
-        lu_symbolic
-            .factorize_numeric_lu(
-                &mut lu,
-                a.as_ref(),
-                par,
-                faer::dyn_stack::MemStack::new(&mut mem),
-                Default::default(),
-            )
-            .unwrap();
-        lu_factor.push(t.elapsed().as_secs_f64());
-        let t = Instant::now();
-        LuRef::new_unchecked(&lu_symbolic, &lu).solve_in_place_with_conj(
-            Conj::No,
-            MatMut::from_column_major_slice_mut(&mut x, n, 1),
-            par,
-            faer::dyn_stack::MemStack::new(&mut mem),
-        );
-        lu_solve.push(t.elapsed().as_secs_f64());
-    }
+    let [lu_factor, lu_solve] = medians(repeats, |stage| {
+        let stack = faer::dyn_stack::MemStack::new(&mut mem);
+        if stage == 0 {
+            lu_symbolic.factorize_numeric_lu(&mut lu, a.as_ref(), par, stack, Default::default()).unwrap();
+        } else {
+            let x = MatMut::from_column_major_slice_mut(&mut x, n, 1);
+            LuRef::new_unchecked(&lu_symbolic, &lu).solve_in_place_with_conj(Conj::No, x, par, stack);
+        }
+    });
 
     let ch_symbolic = factorize_symbolic_cholesky(
         a.symbolic(),
@@ -96,38 +97,27 @@ fn main() {
             .factorize_numeric_llt_scratch::<f64>(par, Default::default())
             .or(ch_symbolic.solve_in_place_scratch::<f64>(1, par)),
     );
-    let (mut ch_factor, mut ch_solve) = (Vec::new(), Vec::new());
-    for _ in 0..repeats {
-        let t = Instant::now();
-        ch_symbolic
-            .factorize_numeric_llt(
-                &mut l,
-                a.as_ref(),
-                Side::Lower,
-                LltRegularization::default(),
-                par,
-                faer::dyn_stack::MemStack::new(&mut mem),
-                Default::default(),
-            )
-            .unwrap();
-        ch_factor.push(t.elapsed().as_secs_f64());
-        let t = Instant::now();
-        LltRef::new(&ch_symbolic, &l).solve_in_place_with_conj(
-            Conj::No,
-            MatMut::from_column_major_slice_mut(&mut x, n, 1),
-            par,
-            faer::dyn_stack::MemStack::new(&mut mem),
-        );
-        ch_solve.push(t.elapsed().as_secs_f64());
-    }
+    let [ch_factor, ch_solve] = medians(repeats, |stage| {
+        let stack = faer::dyn_stack::MemStack::new(&mut mem);
+        if stage == 0 {
+            let regularization = LltRegularization::default();
+            let a = a.as_ref();
+            ch_symbolic
+                .factorize_numeric_llt(&mut l, a, Side::Lower, regularization, par, stack, Default::default())
+                .unwrap();
+        } else {
+            let x = MatMut::from_column_major_slice_mut(&mut x, n, 1);
+            LltRef::new(&ch_symbolic, &l).solve_in_place_with_conj(Conj::No, x, par, stack);
+        }
+    });
     println!(
         "{counts:?}: n = {n}, nnz(A) = {}, nnz(L) Cholesky/AMD = {}; median of {repeats}: LU (COLAMD) factor {:.2} ms, \
          solve {:.3} ms; Cholesky (AMD) factor {:.2} ms, solve {:.3} ms",
         a.compute_nnz(),
         ch_symbolic.len_val(),
-        1e3 * median(lu_factor),
-        1e3 * median(lu_solve),
-        1e3 * median(ch_factor),
-        1e3 * median(ch_solve)
+        lu_factor,
+        lu_solve,
+        ch_factor,
+        ch_solve
     );
 }
