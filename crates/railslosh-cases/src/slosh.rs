@@ -16,7 +16,8 @@
 //! long validation (`railslosh validate`).
 
 use ancf_core::FluidBody;
-use ancf_core::constitutive::{Fluid, Rheology};
+use ancf_core::body::rigid_motion;
+use ancf_core::constitutive::{Fluid, M3, Rheology};
 use ancf_core::contact::{WallContact, WallContactLaw};
 use ancf_core::element::QuadratureOptions;
 use ancf_core::error::{AncfError, Result};
@@ -642,7 +643,7 @@ fn amplitude(t: &[f64], x: &[f64], ta: f64, tb: f64) -> f64 {
 /// [`t_a`, `t_end`] (1/s), from every accepted step of the run as it goes on to `t_end` with
 /// steps ≤ `h` (the steps of [`SloshRun::run_to`]): P_v = u·f_v the power of the deviatoric
 /// viscous stress alone (the body's fluid without its bulk penalty, bulk viscosity and
-/// stabilizations) and T = ½ uᵀMu, u the velocity relative to the (translating) tank. For
+/// stabilizations) and T = ½ uᵀMu, u the velocity relative to the tank's rigid motion. For
 /// linear sloshing in a tank with free-slip walls P_v = 8νk_n² T for each mode n
 /// ([`rail_mbs::slosh::linear_theory`], "Viscous dissipation"; Lamb §348).
 fn viscous_to_kinetic(run: &mut SloshRun, t_a: f64, t_end: f64, h: f64) -> Result<f64> {
@@ -659,19 +660,14 @@ fn viscous_to_kinetic(run: &mut SloshRun, t_a: f64, t_end: f64, h: f64) -> Resul
         if t < t_a - 1e-12 {
             return Ok(());
         }
-        let sys = run.stepper.system();
-        let tank = sys.motion.state(t).kinematics.velocity;
-        let mut u = run.stepper.v().to_vec();
-        for (k, x) in u.iter_mut().enumerate() {
-            // the position coordinates of node j are 12 j .. 12 j + 2; a translation leaves
-            // the gradients alone
-            if k % 12 < 3 {
-                *x -= tank[k % 12];
-            }
-        }
-        viscous
-            .internal_forces(run.stepper.q(), &u, &mut f)
-            .map_err(|e| IntegratorError::InvalidSystem { what: e.to_string() })?;
+        let (sys, q) = (run.stepper.system(), run.stepper.q());
+        // the tank's rigid velocity field at the liquid's coordinates: V + ω × (x − R) at
+        // positions, ω × g at gradients
+        let tank = sys.motion.state(t).kinematics;
+        let origin = tank.position.map(|r| -r);
+        let (_, rigid) = rigid_motion(q, &M3::identity(), origin, tank.angular_velocity, tank.velocity);
+        let u: Vec<f64> = run.stepper.v().iter().zip(&rigid).map(|(v, w)| v - w).collect();
+        viscous.internal_forces(q, &u, &mut f).map_err(|e| IntegratorError::InvalidSystem { what: e.to_string() })?;
         samples.push([t, u.iter().zip(&f).map(|(a, b)| a * b).sum::<f64>(), sys.body.kinetic_energy(&u)]);
         Ok(())
     })
