@@ -20,7 +20,7 @@ use ancf_core::body::rigid_motion;
 use ancf_core::constitutive::{Fluid, M3, Rheology};
 use ancf_core::contact::{WallContact, WallContactLaw};
 use ancf_core::element::QuadratureOptions;
-use ancf_core::error::{AncfError, Result};
+use ancf_core::error::{AncfError, Result, invalid};
 use ancf_core::mesh::{CylinderTankSpec, FluidMesh, box_mesh, cylinder_tank, cylinder_tank_compartments};
 use ancf_core::tank::{Bulkhead, TankGeometry, TankShape};
 
@@ -60,7 +60,7 @@ pub fn run_case(name: &str, quick: bool) -> Result<Vec<Record>> {
         "slosh-linear-potential-flow" => slosh_linear_potential_flow(quick),
         "slosh-load-convergence" => slosh_load_convergence(quick),
         "rest-state" => rest_state(quick),
-        other => Err(ancf_core::error::invalid("case", other, &format!("one of {CASES:?}"))),
+        other => Err(invalid("case", other, &format!("one of {CASES:?}"))),
     }
 }
 
@@ -704,15 +704,9 @@ fn slosh_viscous_decay(quick: bool) -> Result<Vec<Record>> {
         )?;
         let mut motion = PrescribedMotion::at_rest([0.0; 3]);
         motion.translation[1] = PiecewiseAcceleration::pulse(0.3 * G, 0.0, 0.5, 0.01)?;
-        // Newtonian liquids (the light crude's Oldroyd law without yield stress or elasticity is
-        // one): their ordering is checked on the viscous dissipation (below)
-        let newtonian = match rh {
-            Rheology::Newtonian { .. } => true,
-            Rheology::Oldroyd { yield_stress, elastic_modulus, .. } => {
-                *yield_stress == 0.0 && elastic_modulus.is_none()
-            }
-            _ => false,
-        };
+        // Newtonian liquids (the light crude's Oldroyd law without yield stress is one): their
+        // ordering is checked on the viscous dissipation (below)
+        let newtonian = fluid.is_effectively_newtonian();
         let law = WallContactLaw::default_for(fluid.density, G, d);
         let (mut r, mass) =
             slosh_run(mesh, fluid, geo, law, QuadratureOptions::default(), motion, SloshFrame::Inertial)?;
@@ -913,10 +907,8 @@ fn slosh_linear_potential_flow(quick: bool) -> Result<Vec<Record>> {
     law.points_per_edge = 4;
     let quad = QuadratureOptions { penalty: 4, ..QuadratureOptions::default() };
     // the run, with the viscous dissipation from every step after t_a
-    let nu = match fluid.rheology {
-        Rheology::Newtonian { viscosity } => viscosity / fluid.density,
-        _ => unreachable!("rect_setup's water is Newtonian"),
-    };
+    let two_eta = fluid.newtonian_two_eta().ok_or_else(|| invalid("fluid", "non-Newtonian", "rect_setup's water"))?;
+    let nu = two_eta / (2.0 * fluid.density);
     let (mut run, mass) = slosh_run(mesh, fluid, geo, law, quad, motion, SloshFrame::Inertial)?;
     let viscous = viscous_to_kinetic(&mut run, t_a, t_b, h)?;
     let rec = run.record;
